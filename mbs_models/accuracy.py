@@ -1,0 +1,111 @@
+"""Solver settings: the accuracy presets and explicit settings for experts.
+
+``simulate(scene, accuracy="standard")`` picks one of :data:`ACCURACY_PRESETS`; experts pass a
+:class:`SolverSettings` instead (any Exudyn dynamic solver, a fixed step or tolerances).
+
+Contract of the settings
+------------------------
+* Adaptive solvers (``DOPRI5``, ``ODE23``): ``relative_tolerance`` and ``absolute_tolerance`` control
+  the local error; ``max_step`` (s) bounds the step so that the time histories stay resolved.
+* Fixed-step solvers (``RK44``, ``RK67``, ``RK33``, ``ExplicitEuler``, ``ExplicitMidpoint``,
+  ``VelocityVerlet``, ``GeneralizedAlpha``, ``TrapezoidalIndex2``): ``step`` (s) is the step size.
+* ``user_functions`` is ``"symbolic"`` (C++ evaluation, default) or ``"python"`` (debuggable).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+from .errors import SceneError
+
+#: Exudyn solvers with automatic step-size control.
+ADAPTIVE_SOLVERS = ("DOPRI5", "ODE23")
+#: Exudyn solvers with a fixed step.
+FIXED_STEP_SOLVERS = ("RK44", "RK67", "RK33", "ExplicitEuler", "ExplicitMidpoint", "VelocityVerlet",
+                      "GeneralizedAlpha", "TrapezoidalIndex2")
+#: Implicit solvers among them (Newton iterations each step).
+IMPLICIT_SOLVERS = ("GeneralizedAlpha", "TrapezoidalIndex2")
+SOLVERS = ADAPTIVE_SOLVERS + FIXED_STEP_SOLVERS
+USER_FUNCTION_BACKENDS = ("symbolic", "python")
+
+
+@dataclass(frozen=True)
+class SolverSettings:
+    """How to integrate a scene with Exudyn.
+
+    Attributes
+    ----------
+    solver: Exudyn dynamic solver name, one of :data:`SOLVERS`.
+    relative_tolerance, absolute_tolerance: adaptive solvers only (dimensionless, m or m/s).
+    max_step: adaptive solvers: the largest step in s.
+    step: fixed-step solvers: the step in s.
+    user_functions: ``"symbolic"`` or ``"python"``.
+    """
+
+    solver: str = "DOPRI5"
+    relative_tolerance: float | None = 1e-8
+    absolute_tolerance: float | None = 1e-10
+    max_step: float | None = 5e-3
+    step: float | None = None
+    user_functions: str = "symbolic"
+
+    def __post_init__(self):
+        if self.solver not in SOLVERS:
+            raise SceneError("solver", f"unknown Exudyn solver {self.solver!r}; allowed: {', '.join(SOLVERS)}")
+        if self.user_functions not in USER_FUNCTION_BACKENDS:
+            raise SceneError("user_functions", f"must be one of {', '.join(USER_FUNCTION_BACKENDS)}, "
+                                               f"got {self.user_functions!r}")
+        if self.adaptive:
+            for key in ("relative_tolerance", "absolute_tolerance"):
+                _positive(key, getattr(self, key), upper=1.0)
+            _positive("max_step", self.max_step, upper=10.0)
+        else:
+            _positive("step", self.step, upper=1.0)
+
+    @property
+    def adaptive(self) -> bool:
+        """True for solvers with automatic step-size control."""
+        return self.solver in ADAPTIVE_SOLVERS
+
+    @property
+    def implicit(self) -> bool:
+        """True for the implicit (Newton-iterating) solvers."""
+        return self.solver in IMPLICIT_SOLVERS
+
+    def label(self) -> str:
+        """Short human-readable description, e.g. ``DOPRI5 rtol=1e-08``."""
+        if self.adaptive:
+            return f"{self.solver} rtol={self.relative_tolerance:g} ({self.user_functions})"
+        return f"{self.solver} h={self.step:g} s ({self.user_functions})"
+
+
+def _positive(key: str, value, upper: float) -> None:
+    if value is None or isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise SceneError(key, f"must be a number in (0, {upper:g}], got {value!r}")
+    if not math.isfinite(value) or value <= 0 or value > upper:
+        raise SceneError(key, f"must be in (0, {upper:g}], got {value!r}")
+
+
+#: Accuracy presets.  All use adaptive DOPRI5 with symbolic user functions; see the README's table
+#: for the error each meets on the paper cases.
+ACCURACY_PRESETS: dict[str, SolverSettings] = {
+    "draft": SolverSettings(relative_tolerance=1e-6, absolute_tolerance=1e-8, max_step=1e-2),
+    "standard": SolverSettings(relative_tolerance=1e-8, absolute_tolerance=1e-10, max_step=5e-3),
+    "reference": SolverSettings(relative_tolerance=1e-11, absolute_tolerance=1e-13, max_step=1e-3),
+}
+
+
+def solver_settings_for(accuracy: str | SolverSettings = "standard", user_functions: str | None = None
+                        ) -> SolverSettings:
+    """Resolve a preset name (or pass through explicit settings), optionally overriding the backend."""
+    if isinstance(accuracy, SolverSettings):
+        settings = accuracy
+    elif isinstance(accuracy, str) and accuracy in ACCURACY_PRESETS:
+        settings = ACCURACY_PRESETS[accuracy]
+    else:
+        raise SceneError("accuracy", f"unknown accuracy {accuracy!r}; allowed: {', '.join(ACCURACY_PRESETS)} "
+                                     "or a SolverSettings")
+    if user_functions is not None:
+        settings = replace(settings, user_functions=user_functions)
+    return settings

@@ -1,0 +1,36 @@
+"""Exceptions raised by the library.
+
+Two kinds of failure matter to users and are kept apart:
+
+* :class:`SceneError` -- the *input* is wrong (a bad scene file, a value out of range, an impossible
+  solver setting).  It always names the offending key so the message can be shown as one line.
+* :class:`SimulationError` -- the input was valid but the *solve* failed (the solver stopped early,
+  produced NaN, or a user function raised).  Nothing half-finished is ever returned as a result.
+"""
+
+from __future__ import annotations
+
+
+class RecoilError(Exception):
+    """Base class of every error raised on purpose by this library."""
+
+
+class SceneError(RecoilError, ValueError):
+    """A scene (or a solver setting) is invalid.
+
+    Parameters
+    ----------
+    key:
+        Dotted path of the offending entry, e.g. ``"contact.gap"`` (``""`` for the whole file).
+    message:
+        What is wrong and what would be allowed.
+    """
+
+    def __init__(self, key: str, message: str):
+        self.key = key
+        self.message = message
+        super().__init__(f"{key}: {message}" if key else message)
+
+
+class SimulationError(RecoilError, RuntimeError):
+    """A solve failed; the message says why (early stop, NaN, exception in a user function...)."""

@@ -1,0 +1,178 @@
+"""``simulate(scene, end_time, accuracy)``: the one entry point to run a scene with Exudyn.
+
+Contract
+--------
+* The scene is assembled with only the items it calls for (:mod:`mbs_models.assembly`).
+* ``accuracy`` is a preset name (``"draft"``, ``"standard"`` default, ``"reference"``) or explicit
+  :class:`~mbs_models.accuracy.SolverSettings`.
+* The return value is a complete :class:`~mbs_models.result.Result`, or a
+  :class:`~mbs_models.errors.SimulationError` is raised: a solver that fails, stops before
+  ``end_time``, or produces NaN/inf never yields a result.  Bad arguments raise
+  :class:`~mbs_models.errors.SceneError` naming the argument.
+* The Exudyn model is released after every run (no growth over thousands of runs).
+"""
+
+from __future__ import annotations
+
+import math
+import time as _time
+
+import exudyn
+import numpy as np
+
+from .accuracy import SolverSettings, solver_settings_for
+from .assembly import Assembly, assemble
+from .errors import SceneError, SimulationError
+from .postprocess import Samples, analyse
+from .result import Result
+from .scene import Scene
+
+#: Longest simulated time accepted, in s.
+MAX_END_TIME = 1.0e4
+#: Most output samples kept for fixed-step solvers (output is thinned beyond this).
+MAX_FIXED_STEP_SAMPLES = 1_000_000
+
+
+def _check_arguments(scene: Scene, end_time: float, impact_threshold: float) -> None:
+    if not isinstance(scene, Scene):
+        raise SceneError("scene", f"must be a Scene, got {type(scene).__name__}")
+    if isinstance(end_time, bool) or not isinstance(end_time, (int, float)) or not math.isfinite(end_time) \
+            or not 0.0 < end_time <= MAX_END_TIME:
+        raise SceneError("end_time", f"must be a number of seconds in (0, {MAX_END_TIME:g}], got {end_time!r}")
+    if isinstance(impact_threshold, bool) or not isinstance(impact_threshold, (int, float)) \
+            or not math.isfinite(impact_threshold) or impact_threshold < 0:
+        raise SceneError("impact_threshold", f"must be a force >= 0 N, got {impact_threshold!r}")
+
+
+def exudyn_simulation_settings(settings: SolverSettings, end_time: float):
+    """Translate :class:`SolverSettings` into Exudyn ``SimulationSettings`` for a run to ``end_time``."""
+    ss = exudyn.SimulationSettings()
+    ti = ss.timeIntegration
+    ti.endTime = float(end_time)
+    ti.verboseMode = 0
+    ss.show.statistics = False
+    ss.show.computationTime = False
+    ss.solution.file.write = False
+    ss.solution.sensors.writePeriod = 0.0  # every step: extrema are refined between step ends
+    if settings.adaptive:
+        ti.automaticStepSize = True
+        ti.numberOfSteps = max(1, math.ceil(end_time / settings.max_step))
+        ti.relativeTolerance = settings.relative_tolerance
+        ti.absoluteTolerance = settings.absolute_tolerance
+        ti.minimumStepSize = min(1e-12, settings.max_step)
+    else:
+        ti.automaticStepSize = False
+        steps = max(1, math.ceil(end_time / settings.step - 1e-9))
+        ti.numberOfSteps = steps
+        if steps > MAX_FIXED_STEP_SAMPLES:
+            ss.solution.sensors.writePeriod = end_time / MAX_FIXED_STEP_SAMPLES
+        if settings.implicit:
+            ti.newton.relativeTolerance = 1e-10
+            ti.newton.absoluteTolerance = 1e-12
+    return ss
+
+
+def _solve(assembly: Assembly, settings: SolverSettings, end_time: float) -> int:
+    """Run Exudyn; return the number of steps.  Raise SimulationError on any failure."""
+    mbs = assembly.mbs
+    ss = exudyn_simulation_settings(settings, end_time)
+    solver_type = getattr(exudyn.DynamicSolverType, settings.solver)
+    print_to_console = exudyn.config.printToConsole
+    exudyn.config.printToConsole = False  # Exudyn's own failure banner; we raise with the reason instead
+    try:
+        success = mbs.SolveDynamic(ss, solverType=solver_type)
+    except Exception as exc:  # Exudyn wraps user-function exceptions in its own error types
+        message = " ".join(str(exc).split())
+        raise SimulationError(f"Exudyn {settings.solver} failed: {message[:500]}") from exc
+    finally:
+        exudyn.config.printToConsole = print_to_console
+    iteration = mbs.sys["dynamicSolver"].it
+    if not success:
+        raise SimulationError(f"Exudyn {settings.solver} reported failure at t = {iteration.currentTime:.6g} s")
+    if iteration.currentTime < end_time * (1.0 - 1e-9):
+        raise SimulationError(f"Exudyn {settings.solver} stopped early at t = {iteration.currentTime:.6g} s "
+                              f"of {end_time:g} s")
+    return int(iteration.currentStepIndex)
+
+
+def _stored(assembly: Assembly, name: str) -> np.ndarray:
+    return np.asarray(assembly.mbs.GetSensorStoredData(assembly.sensors[name]), dtype=float)
+
+
+def _collect(assembly: Assembly, end_time: float, settings: SolverSettings) -> tuple[Samples, np.ndarray | None]:
+    """Read the sensors into :class:`Samples`; raise SimulationError for NaN/inf or missing output."""
+    columns = {name: _stored(assembly, name) for name in assembly.sensors}
+    time = columns["barrel_position"][:, 0]
+    if len(time) < 2:
+        raise SimulationError(f"Exudyn {settings.solver} produced fewer than two output samples")
+    for name, data in columns.items():
+        if not np.all(np.isfinite(data)):
+            first = int(np.flatnonzero(~np.all(np.isfinite(data), axis=1))[0])
+            raise SimulationError(f"Exudyn {settings.solver} produced a non-finite {name.replace('_', ' ')} at "
+                                  f"t = {data[first, 0]:.6g} s (the solve diverged; try a smaller step or "
+                                  "tighter tolerance)")
+    if abs(time[-1] - end_time) > 1e-6 * max(1.0, end_time):
+        raise SimulationError(f"Exudyn {settings.solver} output ends at t = {time[-1]:.6g} s, not at {end_time:g} s")
+    keep = np.concatenate([[True], np.diff(time) > 0])  # drop duplicate time stamps, if any
+    values = {name: data[keep, 1] for name, data in columns.items()}
+    samples = Samples(time=time[keep], barrel_position=values["barrel_position"],
+                      barrel_velocity=values["barrel_velocity"], barrel_acceleration=values["barrel_acceleration"],
+                      absorber_position=values.get("absorber_position"),
+                      absorber_velocity=values.get("absorber_velocity"),
+                      absorber_acceleration=values.get("absorber_acceleration"))
+    return samples, values.get("contact_force")
+
+
+def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSettings = "standard", *,
+             user_functions: str | None = None, impact_threshold: float = 1000.0) -> Result:
+    """Simulate ``scene`` from t = 0 to ``end_time`` (s) with Exudyn and return a :class:`Result`.
+
+    Parameters
+    ----------
+    scene: the validated scene (see :func:`mbs_models.load_scene`, :func:`mbs_models.model_ii`).
+    end_time: simulated time in s, in (0, 1e4]; the paper uses 10 s.
+    accuracy: ``"draft"``, ``"standard"`` (default) or ``"reference"``, or a :class:`SolverSettings`.
+    user_functions: override the settings' backend: ``"symbolic"`` (C++) or ``"python"``.
+    impact_threshold: a contact episode counts as an impact when its peak force exceeds this (N).
+
+    Raises
+    ------
+    SceneError: an argument is invalid (the message names it).
+    SimulationError: the solve failed, stopped early or produced non-finite values.
+    """
+    _check_arguments(scene, end_time, impact_threshold)
+    settings = solver_settings_for(accuracy, user_functions)
+    t_start = _time.perf_counter()
+    assembly = assemble(scene, settings.user_functions)
+    t_assembled = _time.perf_counter()
+    try:
+        steps = _solve(assembly, settings, float(end_time))
+        t_solved = _time.perf_counter()
+        samples, contact_force = _collect(assembly, float(end_time), settings)
+    finally:
+        assembly.close()
+    metrics = analyse(scene, samples, contact_force, float(impact_threshold))
+    for name in ("max_barrel_displacement", "max_absorber_velocity", "peak_contact_force"):
+        value = getattr(metrics, name)
+        if value is not None and not math.isfinite(value):
+            raise SimulationError(f"post-processing produced a non-finite {name.replace('_', ' ')}")
+    t_end = _time.perf_counter()
+    dissipated_history = metrics.dissipated_energy_history
+    return Result(
+        scene=scene, settings=settings, end_time=float(end_time), time=samples.time,
+        barrel_position=samples.barrel_position, barrel_velocity=samples.barrel_velocity,
+        barrel_acceleration=samples.barrel_acceleration, absorber_position=samples.absorber_position,
+        absorber_velocity=samples.absorber_velocity, absorber_acceleration=samples.absorber_acceleration,
+        contact_force=contact_force,
+        max_barrel_displacement=metrics.max_barrel_displacement,
+        time_of_max_barrel_displacement=metrics.time_of_max_barrel_displacement,
+        peak_contact_force=metrics.peak_contact_force, time_of_peak_contact_force=metrics.time_of_peak_contact_force,
+        max_absorber_velocity=metrics.max_absorber_velocity,
+        time_of_max_absorber_velocity=metrics.time_of_max_absorber_velocity,
+        impacts=metrics.impacts, impact_threshold=float(impact_threshold),
+        dissipated_energy={name: float(history[-1]) for name, history in dissipated_history.items()},
+        dissipated_energy_history=dissipated_history, stored_energy_history=metrics.stored_energy_history,
+        kinetic_energy_history=metrics.kinetic_energy_history,
+        wall_time=t_end - t_start, steps=steps,
+        timings={"assembly": t_assembled - t_start, "solve": t_solved - t_assembled, "postprocess": t_end - t_solved},
+    )
