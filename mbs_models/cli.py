@@ -1,0 +1,121 @@
+"""The ``recoil`` command line.
+
+Exit codes: 0 success; 1 a simulation or check failed; 2 bad input (one line on stderr naming the
+problem, never a traceback for user mistakes).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+from typing import Sequence
+
+from .errors import SceneError, SimulationError
+from .scene_io import load_scene
+
+EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
+_ARGUMENT_NAMES = {"end_time": "--end-time", "accuracy": "--accuracy", "impact_threshold": "--impact-threshold",
+                   "user_functions": "--user-functions"}
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors and exit code 2."""
+
+    def error(self, message: str):
+        raise SceneError("", f"{message} (see '{self.prog} --help')")
+
+
+def _progress(message: str) -> None:
+    print(f"[recoil] {message}", file=sys.stderr, flush=True)
+
+
+def _resolve_scene(path: str):
+    """A scene file path, or the name of a shipped scene (``simplified``, ``model_i``, ``model_ii``)."""
+    candidate = Path(path)
+    if not candidate.exists() and candidate.suffix == "" and "/" not in path:
+        from .scenes import list_scenes, scene_path
+        if path in list_scenes():
+            candidate = scene_path(path)
+    return load_scene(candidate)
+
+
+def _cmd_run(args) -> int:
+    from .simulate import simulate
+
+    scene = _resolve_scene(args.scene)
+    if args.plot:
+        from .outputs import prepare_output_dir
+        prepare_output_dir(Path(args.plot).parent or Path("."), key="--plot")
+    result = simulate(scene, args.end_time, args.accuracy, user_functions=args.user_functions,
+                      impact_threshold=args.impact_threshold)
+    if args.plot:
+        from .plotting import plot_result, save_figure
+        save_figure(plot_result(result), args.plot)
+    if args.json:
+        print(json.dumps(result.metrics(), indent=2, allow_nan=False))
+    else:
+        print(result.summary())
+        if args.plot:
+            print(f"  plot                     {args.plot}")
+    return EXIT_OK
+
+
+def _cmd_paper(args) -> int:
+    from validation.replication import table2_markdown, write_paper_outputs
+
+    start = time.perf_counter()
+    written = write_paper_outputs(args.out, accuracy=args.accuracy, end_time=args.end_time, progress=_progress)
+    print(table2_markdown(written["table2"]))
+    count = sum(len(paths) for paths in written["figures"].values())
+    print(f"wrote table2.md, table2.json and {count} figures to {written['out']} "
+          f"in {time.perf_counter() - start:.1f} s")
+    return EXIT_OK
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="recoil", description="Recoil mechanisms with impact absorbers (Exudyn).")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    run = sub.add_parser("run", help="simulate one scene and print its metrics")
+    run.add_argument("scene", help="scene TOML file (or a shipped scene: simplified, model_i, model_ii)")
+    run.add_argument("--end-time", type=float, default=10.0, help="simulated time in s (default 10)")
+    run.add_argument("--accuracy", default="standard", choices=("draft", "standard", "reference"))
+    run.add_argument("--json", action="store_true", help="print the metrics as one JSON object")
+    run.add_argument("--plot", metavar="FILE", help="write the time histories as PNG")
+    run.add_argument("--user-functions", choices=("symbolic", "python"), default=None,
+                     help="user-function backend (default symbolic; python is slower, for debugging)")
+    run.add_argument("--impact-threshold", type=float, default=1000.0,
+                     help="peak force (N) above which a contact episode counts as an impact (default 1000)")
+    run.set_defaults(handler=_cmd_run)
+
+    paper = sub.add_parser("paper", help="reproduce the paper: Table 2 and the figures")
+    paper.add_argument("--out", default="out", help="output directory (default ./out)")
+    paper.add_argument("--accuracy", default="standard", choices=("draft", "standard", "reference"))
+    paper.add_argument("--end-time", type=float, default=10.0, help="simulated time in s (default 10)")
+    paper.set_defaults(handler=_cmd_paper)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``recoil`` console script; returns the exit code."""
+    try:
+        args = build_parser().parse_args(argv)
+        return args.handler(args)
+    except SceneError as exc:
+        key = _ARGUMENT_NAMES.get(exc.key, exc.key)
+        message = f"{key}: {exc.message}" if key else exc.message
+        print(f"recoil: error: {message}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except SimulationError as exc:
+        print(f"recoil: simulation failed: {exc}", file=sys.stderr)
+        return EXIT_FAILED
+    except KeyboardInterrupt:
+        print("recoil: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,59 @@
+"""Writing output files safely: check the directory first, write to a temporary name, then rename.
+
+A report that fails half-way never leaves a half-written file under its final name.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from pathlib import Path
+from typing import Any
+
+from .errors import SceneError
+
+
+def prepare_output_dir(path: str | Path, key: str = "--out") -> Path:
+    """Create ``path`` if needed and check it is a writable directory; SceneError naming ``key`` if not."""
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise SceneError(key, f"{path} exists and is not a directory")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise SceneError(key, f"cannot create output directory {path}: {exc.strerror or exc}") from None
+    if not os.access(path, os.W_OK | os.X_OK):
+        raise SceneError(key, f"output directory {path} is not writable")
+    return path
+
+
+def atomic_write_bytes(path: str | Path, data: bytes) -> Path:
+    """Write ``data`` to ``path`` via a temporary file in the same directory and an atomic rename."""
+    path = Path(path)
+    directory = path.parent if str(path.parent) else Path(".")
+    try:
+        handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=directory)
+    except OSError as exc:
+        raise SceneError(str(path), f"cannot write: {exc.strerror or exc}") from None
+    try:
+        with os.fdopen(handle, "wb") as stream:
+            stream.write(data)
+        os.replace(temporary, path)
+    except BaseException:
+        try:
+            os.unlink(temporary)
+        except OSError:
+            pass
+        raise
+    return path
+
+
+def atomic_write_text(path: str | Path, text: str) -> Path:
+    """Write UTF-8 text atomically."""
+    return atomic_write_bytes(path, text.encode("utf-8"))
+
+
+def atomic_write_json(path: str | Path, data: Any) -> Path:
+    """Write JSON (indented, NaN forbidden: non-finite numbers must never pass as results)."""
+    return atomic_write_text(path, json.dumps(data, indent=2, allow_nan=False) + "\n")

@@ -1,0 +1,168 @@
+"""Engineering plots of results: units on axes, legends, readable at 100 %.
+
+Uses matplotlib's object-oriented API (``Figure`` + Agg canvas): no global pyplot state and no
+display needed, so it is safe in scripts, tests and worker processes.
+"""
+
+from __future__ import annotations
+
+import io
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from .outputs import atomic_write_bytes
+from .result import Result
+
+#: One colour per model, used consistently in every figure.
+MODEL_COLOURS = {"simplified": "#444444", "model (i)": "#1f77b4", "model (ii)": "#d62728"}
+FIGURE_DPI = 110
+
+
+def new_figure(rows: int = 1, cols: int = 1, *, width: float = 8.0, row_height: float = 3.0,
+               sharex: bool = False) -> tuple[Figure, np.ndarray]:
+    """A figure with a grid of axes (always returned as a 2-D array) and the house style."""
+    fig = Figure(figsize=(width, row_height * rows), dpi=FIGURE_DPI, layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = np.atleast_2d(fig.subplots(rows, cols, sharex=sharex, squeeze=False))
+    for ax in axes.flat:
+        ax.grid(True, alpha=0.35)
+        ax.tick_params(labelsize=9)
+    return fig, axes
+
+
+def figure_png(fig: Figure) -> bytes:
+    """Render a figure to PNG bytes."""
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=FIGURE_DPI)
+    return buffer.getvalue()
+
+
+def save_figure(fig: Figure, path: str | Path) -> Path:
+    """Write a figure as PNG atomically (temporary name, then rename)."""
+    return atomic_write_bytes(path, figure_png(fig))
+
+
+def plot_result(result: Result, *, title: str | None = None) -> Figure:
+    """Time histories of one run: barrel (and absorber) position; contact force; absorber velocity."""
+    has_absorber = result.absorber_position is not None
+    rows = 3 if has_absorber else 2
+    fig, axes = new_figure(rows, 1, row_height=2.6, sharex=True)
+    ax = axes[0, 0]
+    ax.plot(result.time, result.barrel_position * 1e3, color=MODEL_COLOURS["simplified"], label="barrel $x_M$")
+    if has_absorber:
+        ax.plot(result.time, result.absorber_position * 1e3, color=MODEL_COLOURS["model (ii)"], label="absorber $x_m$")
+    ax.plot([result.time_of_max_barrel_displacement], [result.max_barrel_displacement * 1e3], "ko", ms=4,
+            label=f"max {result.max_barrel_displacement * 1e3:.2f} mm")
+    ax.set_ylabel("position [mm]")
+    ax.legend(fontsize=8, loc="upper right")
+    ax = axes[1, 0]
+    if has_absorber:
+        ax.plot(result.time, result.contact_force / 1e3, color=MODEL_COLOURS["model (i)"], lw=1.0)
+        if result.peak_contact_force:
+            ax.plot([result.time_of_peak_contact_force], [result.peak_contact_force / 1e3], "ko", ms=4,
+                    label=f"peak {result.peak_contact_force / 1e3:.1f} kN")
+            ax.legend(fontsize=8, loc="upper right")
+        ax.set_ylabel("contact force [kN]")
+        ax = axes[2, 0]
+        ax.plot(result.time, result.absorber_velocity, color=MODEL_COLOURS["model (ii)"], lw=1.0,
+                label="absorber $\\dot x_m$")
+        ax.plot(result.time, result.barrel_velocity, color=MODEL_COLOURS["simplified"], lw=1.0,
+                label="barrel $\\dot x_M$")
+        ax.set_ylabel("velocity [m/s]")
+        ax.legend(fontsize=8, loc="upper right")
+    else:
+        ax.plot(result.time, result.barrel_velocity, color=MODEL_COLOURS["simplified"], label="barrel $\\dot x_M$")
+        ax.set_ylabel("velocity [m/s]")
+        ax.legend(fontsize=8, loc="upper right")
+    axes[-1, 0].set_xlabel("time [s]")
+    fig.suptitle(title or result.scene.name, fontsize=11)
+    return fig
+
+
+def plot_barrel_displacements(results: Sequence[Result], *, title: str) -> Figure:
+    """Barrel displacement of several models over time, as the paper's Figs 6-8."""
+    fig, axes = new_figure(1, 1, row_height=3.6)
+    ax = axes[0, 0]
+    for result in results:
+        colour = MODEL_COLOURS.get(result.scene.model_label)
+        ax.plot(result.time, result.barrel_position * 1e3, color=colour,
+                label=f"{result.scene.model_label}: max {result.max_barrel_displacement:.4f} m")
+        ax.plot([result.time_of_max_barrel_displacement], [result.max_barrel_displacement * 1e3], "o",
+                color=colour, ms=4)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("barrel displacement $x_M$ [mm]")
+    ax.set_title(title, fontsize=11)
+    ax.legend(fontsize=9)
+    return fig
+
+
+#: The paper's detail windows of Figs 9b/9d and 10b/10d, in s ("main effective impacts").
+PAPER_ZOOM_WINDOWS = {"model (i)": 3.25, "model (ii)": 1.15}
+
+
+def plot_contact_histories(results: Sequence[Result], quantity: str, *, title: str,
+                           zoom_windows: dict[str, float] | None = None) -> Figure:
+    """Contact force or absorber velocity of models (i) and (ii), full run and zoom (Figs 9-10).
+
+    ``quantity`` is ``"contact_force"`` (kN) or ``"absorber_velocity"`` (m/s).  With zoom windows,
+    ``zoom_windows`` maps a model label to a window (s): the right-hand panels then show the first
+    seconds of that model's run (the main effective impacts; the paper's windows by default).
+    """
+    scale, label = (1e-3, "contact force $F_{ct}$ [kN]") if quantity == "contact_force" else \
+        (1.0, "absorber velocity $\\dot x_m$ [m/s]")
+    zoom_windows = PAPER_ZOOM_WINDOWS if zoom_windows is None else zoom_windows
+    cols = 2 if zoom_windows else 1
+    fig, axes = new_figure(len(results), cols, width=10.0 if cols == 2 else 8.0, row_height=2.8)
+    for row, result in enumerate(results):
+        values = getattr(result, quantity) * scale
+        colour = MODEL_COLOURS.get(result.scene.model_label)
+        zoom_window = zoom_windows.get(result.scene.model_label, 1.0) if zoom_windows else None
+        for col in range(cols):
+            ax = axes[row, col]
+            if col == 1:
+                mask = result.time <= zoom_window
+                ax.plot(result.time[mask], values[mask], color=colour, lw=1.0)
+                ax.set_title(f"{result.scene.model_label}: first {zoom_window:g} s", fontsize=10)
+            else:
+                ax.plot(result.time, values, color=colour, lw=1.0)
+                ax.set_title(f"{result.scene.model_label}: {result.end_time:g} s", fontsize=10)
+            if quantity == "contact_force" and result.peak_contact_force:
+                ax.plot([result.time_of_peak_contact_force], [result.peak_contact_force * scale], "ko", ms=4,
+                        label=f"peak {result.peak_contact_force / 1e3:.1f} kN")
+                ax.legend(fontsize=8, loc="upper right")
+            if quantity == "absorber_velocity" and result.max_absorber_velocity is not None:
+                ax.plot([result.time_of_max_absorber_velocity], [result.max_absorber_velocity], "ko", ms=4,
+                        label=f"max {result.max_absorber_velocity:.3f} m/s at "
+                              f"{result.time_of_max_absorber_velocity:.4f} s")
+                ax.legend(fontsize=8, loc="upper right")
+            ax.set_ylabel(label, fontsize=9)
+            ax.set_xlabel("time [s]")
+    fig.suptitle(title, fontsize=11)
+    return fig
+
+
+def plot_first_impact(results: Sequence[Result], *, title: str, padding: float = 0.25) -> Figure:
+    """Contact force over the first impact of each model, zoomed to its duration (Fig. 11)."""
+    fig, axes = new_figure(1, len(results), width=5.0 * len(results), row_height=3.4)
+    for col, result in enumerate(results):
+        ax = axes[0, col]
+        colour = MODEL_COLOURS.get(result.scene.model_label)
+        if not result.impacts:
+            ax.text(0.5, 0.5, "no impact", ha="center", transform=ax.transAxes)
+            continue
+        impact = result.impacts[0]
+        margin = padding * impact.duration
+        mask = (result.time >= impact.start - margin) & (result.time <= impact.end + margin)
+        ax.plot(result.time[mask] * 1e3, result.contact_force[mask] / 1e3, ".-", color=colour, lw=1.0, ms=3)
+        ax.plot([impact.time_of_peak_force * 1e3], [impact.peak_force / 1e3], "ko", ms=4,
+                label=f"peak {impact.peak_force / 1e3:.1f} kN, {impact.duration * 1e3:.2f} ms long")
+        ax.set_title(result.scene.model_label, fontsize=10)
+        ax.set_xlabel("time [ms]")
+        ax.set_ylabel("contact force [kN]")
+        ax.legend(fontsize=8)
+    fig.suptitle(title, fontsize=11)
+    return fig

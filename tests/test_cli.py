@@ -1,0 +1,104 @@
+"""The ``recoil`` command line: bad input gives one line on stderr and exit code 2."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import tomllib
+
+import pytest
+
+from mbs_models import model_ii, scene_to_toml
+from mbs_models.cli import main
+
+
+def _write_toml(path, data: dict) -> None:
+    lines = []
+    scalars = {k: v for k, v in data.items() if not isinstance(v, dict)}
+    tables = {k: v for k, v in data.items() if isinstance(v, dict)}
+
+    def value(v):
+        if isinstance(v, bool):
+            return "true" if v else "false"
+        if isinstance(v, str):
+            return json.dumps(v)
+        if isinstance(v, float) and v != v:
+            return "nan"
+        if isinstance(v, float) and v in (float("inf"), float("-inf")):
+            return "inf" if v > 0 else "-inf"
+        return repr(v)
+
+    lines += [f"{k} = {value(v)}" for k, v in scalars.items()]
+    for name, table in tables.items():
+        lines.append(f"[{name}]")
+        lines += [f"{k} = {value(v)}" for k, v in table.items()]
+    path.write_text("\n".join(lines) + "\n")
+
+
+def test_bad_scene_via_cli(tmp_path, capsys, bad_scene):
+    data, key, text = bad_scene
+    path = tmp_path / "bad.toml"
+    _write_toml(path, data)
+    assert tomllib.loads(path.read_text()) is not None
+    code = main(["run", str(path)])
+    captured = capsys.readouterr()
+    assert code == 2
+    lines = captured.err.strip().splitlines()
+    assert len(lines) == 1, captured.err
+    assert key in lines[0] and text in lines[0]
+    assert "Traceback" not in captured.err
+    assert captured.out == ""
+
+
+def test_console_script_reports_without_traceback(tmp_path):
+    path = tmp_path / "bad.toml"
+    path.write_text(scene_to_toml(model_ii()).replace("gap = 0.0", "gap = -0.5"))
+    proc = subprocess.run([sys.executable, "-m", "mbs_models", "run", str(path)], capture_output=True, text=True)
+    assert proc.returncode == 2
+    assert proc.stderr.strip() == "recoil: error: contact.gap: must be >= 0 m, got -0.5"
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (["run", "model_ii", "--end-time", "0"], "--end-time"),
+    (["run", "model_ii", "--end-time", "nan"], "--end-time"),
+    (["run", "model_ii", "--accuracy", "sloppy"], "--accuracy"),
+    (["run", "model_ii", "--impact-threshold", "-1"], "--impact-threshold"),
+    (["run"], "scene"),
+    (["frobnicate"], "invalid choice"),
+])
+def test_bad_arguments_exit_2(capsys, argv, needle):
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and needle in err
+
+
+def test_run_json_has_design_keys(capsys):
+    assert main(["run", "model_ii", "--json", "--end-time", "1.0"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    for key in ("max_barrel_displacement", "time_of_max_barrel_displacement", "peak_contact_force",
+                "max_absorber_velocity", "time_of_max_absorber_velocity", "impacts", "wall_time"):
+        assert key in data
+    assert all(set(impact) >= {"start", "end", "peak_force"} for impact in data["impacts"])
+    assert data["impacts"] and data["peak_contact_force"] == max(i["peak_force"] for i in data["impacts"])
+
+
+def test_run_simplified_json_has_null_contact_metrics(capsys):
+    assert main(["run", "simplified", "--json", "--end-time", "2"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["peak_contact_force"] is None and data["max_absorber_velocity"] is None
+    assert data["impacts"] == []
+
+
+def test_run_plot_writes_png(tmp_path, capsys):
+    target = tmp_path / "plots" / "run.png"
+    assert main(["run", "model_i", "--end-time", "1", "--plot", str(target)]) == 0
+    assert target.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "max barrel displacement" in capsys.readouterr().out
+
+
+def test_plot_into_unwritable_place_is_bad_input(tmp_path, capsys):
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    assert main(["run", "model_i", "--end-time", "1", "--plot", str(blocker / "run.png")]) == 2
+    assert "--plot" in capsys.readouterr().err

@@ -1,0 +1,40 @@
+"""Refinement of extrema and crossings between samples (mbs_models.peaks)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from mbs_models.peaks import HermiteTrajectory, refine_crossing, refine_function_maximum, refine_maximum
+
+
+def test_hermite_reproduces_cubics_exactly():
+    t = np.array([0.0, 0.3, 1.0, 1.7])
+    y = lambda x: 2 * x ** 3 - x ** 2 + 0.5 * x - 1  # noqa: E731
+    dy = lambda x: 6 * x ** 2 - 2 * x + 0.5  # noqa: E731
+    interp = HermiteTrajectory(t, y(t), dy(t))
+    grid = np.linspace(0, 1.7, 101)
+    np.testing.assert_allclose(interp(grid), y(grid), rtol=1e-13, atol=1e-13)
+
+
+def test_refine_maximum_of_a_sine_sampled_coarsely():
+    t = np.linspace(0.0, 3.0, 7)  # h = 0.5 s; the maximum at pi/2 lies between samples
+    value, time = refine_maximum(t, np.sin(t), np.cos(t))
+    assert time == pytest.approx(np.pi / 2, abs=2e-3)
+    assert value == pytest.approx(1.0, abs=1e-3)
+    assert value > np.sin(t).max() + 0.01  # the raw sample maximum is clearly below
+
+
+def test_refine_function_maximum_of_a_narrow_pulse():
+    t = np.linspace(0.0, 0.03, 4)  # samples miss the 15 ms pulse's top
+    pulse = lambda x: np.where((x > 0) & (x < 0.015), np.sin(np.pi * x / 0.015), 0.0) * 1e5  # noqa: E731
+    k = int(np.argmax(pulse(t)))
+    value, time = refine_function_maximum(pulse, t, k)
+    assert value == pytest.approx(1e5, rel=1e-9)
+    assert time == pytest.approx(0.0075, abs=1e-8)
+
+
+def test_refine_crossing_finds_switch_time():
+    switch = 0.123456789
+    found = refine_crossing(lambda x: x >= switch, 0.1, 0.2)
+    assert found == pytest.approx(switch, abs=1e-9)

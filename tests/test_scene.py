@@ -1,0 +1,86 @@
+"""Scene validation through the Python API (mbs_models.scene, mbs_models.scene_io)."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from mbs_models import (Absorber, Barrel, Contact, Conventions, SceneError, load_scene, model_i, model_ii,
+                        scene_from_dict, scene_to_dict, scene_to_toml, simplified_model)
+from mbs_models.scenes import list_scenes, scene_path
+
+
+def test_bad_scene_raises_scene_error_naming_the_key(bad_scene):
+    data, key, text = bad_scene
+    with pytest.raises(SceneError) as info:
+        scene_from_dict(data)
+    assert info.value.key == key
+    assert str(info.value).startswith(f"{key}:")
+    assert text in str(info.value)
+
+
+def test_dataclasses_validate_when_built_in_python():
+    with pytest.raises(SceneError, match=r"barrel\.mass"):
+        Barrel(mass=-1.0, initial_velocity=0.7)
+    with pytest.raises(SceneError, match=r"contact\.gap"):
+        Contact(gap=math.nan, stiffness=1e8, exponent=1.5, damping_factor=0.1)
+    with pytest.raises(SceneError, match=r"absorber\.mount"):
+        Absorber(mass=1.0, mount="wall", stiffness=0.0, damping=0.0)
+    with pytest.raises(SceneError, match=r"conventions\.compression_only"):
+        Conventions(compression_only=1)
+
+
+def test_malformed_toml_is_a_scene_error(tmp_path):
+    path = tmp_path / "bad.toml"
+    path.write_text("[barrel\nmass = 1\n")
+    with pytest.raises(SceneError, match="malformed TOML"):
+        load_scene(path)
+
+
+def test_missing_and_directory_paths_are_scene_errors(tmp_path):
+    with pytest.raises(SceneError, match="not found"):
+        load_scene(tmp_path / "nope.toml")
+    with pytest.raises(SceneError, match="directory"):
+        load_scene(tmp_path)
+
+
+@pytest.mark.parametrize("scene", [simplified_model(), model_i(100.0, 0.04), model_ii(500.0, 0.12)],
+                         ids=["simplified", "model-i", "model-ii"])
+def test_toml_round_trip(tmp_path, scene):
+    path = tmp_path / "scene.toml"
+    path.write_text(scene_to_toml(scene))
+    assert load_scene(path) == scene
+    assert scene_from_dict(scene_to_dict(scene)) == scene
+
+
+def test_shipped_scenes_are_the_paper_models():
+    assert list_scenes() == ["model_i", "model_ii", "simplified"]
+    assert load_scene(scene_path("simplified")) == simplified_model()
+    assert load_scene(scene_path("model_i")) == model_i(1000.0, 0.0)
+    assert load_scene(scene_path("model_ii")) == model_ii(1000.0, 0.0)
+
+
+def test_initial_velocity_from_momentum_and_conventions():
+    assert simplified_model().initial_velocity == pytest.approx(6.86 * 564 / 5600, rel=1e-15)
+    rounded = simplified_model(Conventions(rounded_initial_velocity=True))
+    assert rounded.initial_velocity == 0.7
+    with_absorber = model_i(1000.0, 0.0, Conventions(v0_includes_absorber=True))
+    assert with_absorber.initial_velocity == pytest.approx(6.86 * 564 / 6600, rel=1e-15)
+    # the absorber on the ground does not ride on the barrel: v0 unchanged
+    assert model_ii(1000.0, 0.0, Conventions(v0_includes_absorber=True)).initial_velocity == pytest.approx(0.6909)
+
+
+def test_with_changes_revalidates():
+    scene = model_ii(1000.0, 0.0)
+    assert scene.with_changes(**{"contact.gap": 0.04}).contact.gap == 0.04
+    with pytest.raises(SceneError, match=r"contact\.gap"):
+        scene.with_changes(**{"contact.gap": -1.0})
+    with pytest.raises(SceneError, match="no \\[absorber\\]"):
+        simplified_model().with_changes(**{"absorber.mass": 1.0})
+
+
+def test_model_labels():
+    assert simplified_model().model_label == "simplified"
+    assert model_i().model_label == "model (i)"
+    assert model_ii().model_label == "model (ii)"

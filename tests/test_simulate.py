@@ -1,0 +1,145 @@
+"""simulate(): physics against closed forms, backends against each other, failures as errors."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import mbs_models.forces as forces
+from mbs_models import (ACCURACY_PRESETS, SceneError, SimulationError, SolverSettings, model_i, model_ii,
+                        simplified_model, simulate)
+
+
+def damped_oscillator_maximum(mass, stiffness, damping, v0):
+    """First maximum of M x'' + c x' + k x = 0, x(0) = 0, x'(0) = v0 (underdamped).
+
+    x(t) = v0/wd exp(-zeta wn t) sin(wd t); x'(t) = 0 where tan(wd t) = wd / (zeta wn).
+    """
+    wn = math.sqrt(stiffness / mass)
+    zeta = damping / (2.0 * math.sqrt(stiffness * mass))
+    assert zeta < 1.0
+    wd = wn * math.sqrt(1.0 - zeta ** 2)
+    t_max = math.atan2(wd, zeta * wn) / wd
+    return v0 / wd * math.exp(-zeta * wn * t_max) * math.sin(wd * t_max), t_max
+
+
+def test_simplified_model_matches_closed_form_maximum():
+    v0 = 6.86 * 564 / 5600
+    x_max, t_max = damped_oscillator_maximum(5600.0, 27500.0, 6239.0, v0)
+    result = simulate(simplified_model(), 10.0)
+    assert result.max_barrel_displacement == pytest.approx(x_max, rel=1e-6)
+    assert result.time_of_max_barrel_displacement == pytest.approx(t_max, rel=1e-5)
+    assert round(x_max, 4) == 0.2215  # the paper's Table 2 value for the simplified model
+
+
+@pytest.mark.parametrize("factory", [model_i, model_ii], ids=["model-i", "model-ii"])
+def test_python_and_symbolic_user_functions_agree(factory):
+    scene = factory(500.0, 0.02)
+    symbolic = simulate(scene, 3.0, user_functions="symbolic")
+    python = simulate(scene, 3.0, user_functions="python")
+    for name in ("max_barrel_displacement", "peak_contact_force", "max_absorber_velocity",
+                 "time_of_max_barrel_displacement", "time_of_peak_contact_force"):
+        assert getattr(python, name) == pytest.approx(getattr(symbolic, name), rel=1e-9), name
+    assert len(python.time) == len(symbolic.time)
+    np.testing.assert_allclose(python.barrel_position, symbolic.barrel_position, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(python.contact_force, symbolic.contact_force, rtol=1e-9, atol=1e-6)
+
+
+@pytest.mark.parametrize("accuracy", list(ACCURACY_PRESETS))
+def test_presets_run_and_report_complete_results(accuracy):
+    result = simulate(model_ii(1000.0, 0.0), 2.0, accuracy)
+    assert result.settings == ACCURACY_PRESETS[accuracy]
+    assert result.time[0] == 0.0 and result.time[-1] == pytest.approx(2.0)
+    assert np.all(np.diff(result.time) > 0)
+    assert np.all(result.contact_force >= 0.0)
+    assert result.impacts, "model (ii) at gap 0 is hit at once"
+    assert result.peak_contact_force == pytest.approx(max(i.peak_force for i in result.impacts))
+    for first, second in zip(result.impacts, result.impacts[1:]):
+        assert first.end < second.start
+    assert all(i.start <= i.time_of_peak_force <= i.end and i.peak_force > 1000.0 for i in result.impacts)
+
+
+def test_simplified_result_has_no_contact_quantities():
+    result = simulate(simplified_model(), 1.0)
+    assert result.contact_force is None and result.absorber_position is None
+    assert result.peak_contact_force is None and result.max_absorber_velocity is None
+    assert result.impacts == []
+    assert set(result.dissipated_energy) == {"recoil_damper"}
+
+
+def test_refined_peak_beats_the_raw_sample_maximum():
+    """At draft accuracy the refined peak is closer to a reference-accuracy peak than the raw samples."""
+    scene = model_ii(1000.0, 0.0)
+    truth = simulate(scene, 0.05, "reference").peak_contact_force
+    draft = simulate(scene, 0.05, "draft")
+    raw = float(draft.contact_force.max())
+    assert abs(draft.peak_contact_force - truth) < abs(raw - truth)
+    assert abs(draft.peak_contact_force - truth) / truth < 1e-3
+
+
+def test_impact_threshold_filters_episodes():
+    scene = model_ii(1000.0, 0.0)
+    few = simulate(scene, 10.0, impact_threshold=20e3)
+    many = simulate(scene, 10.0, impact_threshold=1e3)
+    assert 0 < len(few.impacts) < len(many.impacts)
+    assert all(i.peak_force > 20e3 for i in few.impacts)
+
+
+def test_energy_is_accounted_for():
+    result = simulate(model_i(1000.0, 0.04), 10.0)
+    e0 = result.scene.initial_kinetic_energy
+    assert np.max(np.abs(result.energy_error())) < 1e-3 * e0
+    assert all(history[-1] >= 0 for history in result.dissipated_energy_history.values())
+    # after 10 s almost everything has been dissipated
+    assert result.total_dissipated_energy == pytest.approx(e0, rel=1e-3)
+
+
+@pytest.mark.parametrize("kwargs, key", [
+    ({"end_time": 0.0}, "end_time"), ({"end_time": -1.0}, "end_time"), ({"end_time": math.inf}, "end_time"),
+    ({"end_time": 1e9}, "end_time"), ({"accuracy": "perfect"}, "accuracy"),
+    ({"impact_threshold": -1.0}, "impact_threshold"), ({"user_functions": "fortran"}, "user_functions"),
+])
+def test_bad_arguments_are_scene_errors(kwargs, key):
+    with pytest.raises(SceneError) as info:
+        simulate(model_ii(), **kwargs)
+    assert info.value.key == key
+
+
+@pytest.mark.parametrize("settings, key", [
+    (dict(solver="Euler"), "solver"), (dict(relative_tolerance=0.0), "relative_tolerance"),
+    (dict(max_step=math.nan), "max_step"), (dict(solver="RK44", step=None), "step"),
+    (dict(solver="RK44", step=5.0), "step"),
+])
+def test_bad_solver_settings(settings, key):
+    with pytest.raises(SceneError) as info:
+        SolverSettings(**settings)
+    assert info.value.key == key
+
+
+def test_exception_in_python_user_function_is_a_simulation_error(monkeypatch):
+    def broken(*args, **kwargs):
+        raise ZeroDivisionError("deliberate failure inside the contact law")
+
+    monkeypatch.setattr(forces, "hunt_crossley_force", broken)
+    with pytest.raises(SimulationError, match="deliberate failure"):
+        simulate(model_ii(), 0.1, user_functions="python")
+
+
+def test_nan_from_user_function_is_a_simulation_error(monkeypatch):
+    original = forces.recoil_damper_force
+
+    def poisoned(velocity, damper, ops=forces.PYTHON_OPS):
+        value = original(velocity, damper, ops)
+        return math.nan if velocity < 0 else value
+
+    monkeypatch.setattr(forces, "recoil_damper_force", poisoned)
+    with pytest.raises(SimulationError, match="non-finite"):
+        simulate(simplified_model(), 2.0, user_functions="python")
+
+
+def test_fixed_step_solver_runs():
+    result = simulate(simplified_model(), 2.0, SolverSettings(solver="RK44", step=1e-3))
+    x_max, _ = damped_oscillator_maximum(5600.0, 27500.0, 6239.0, 6.86 * 564 / 5600)
+    assert result.max_barrel_displacement == pytest.approx(x_max, rel=1e-8)
