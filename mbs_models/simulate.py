@@ -95,13 +95,46 @@ def _solve(assembly: Assembly, settings: SolverSettings, end_time: float) -> int
     return int(iteration.currentStepIndex)
 
 
+def _initial_accelerations(assembly: Assembly) -> dict[str, float]:
+    """Accelerations (m/s^2) of each body at the initial state, from Exudyn's own force evaluation.
+
+    Exudyn's explicit solvers record the acceleration sensors at t = 0 as 0 (nothing is evaluated
+    before the first step); the Hermite interpolation of the velocity on the first step -- and so the
+    dissipated energy and refined extrema there -- needs the true value.  Call before solving.
+    """
+    mbs, data = assembly.mbs, assembly.mbs.systemData
+    lhs = np.zeros(data.ODE2Size())
+    mass = np.zeros((data.ODE2Size(), data.ODE2Size()))
+    try:
+        for i in range(data.NumberOfObjects()):
+            index = exudyn.ObjectIndex(i)
+            ltg = list(data.GetObjectLTGODE2(i))
+            if not ltg:
+                continue
+            applies = mbs.ComputeItem(index)
+            if exudyn.ComputeItemType.MassMatrix in applies:
+                mass[np.ix_(ltg, ltg)] += np.asarray(mbs.ComputeItem(index, exudyn.ComputeItemType.MassMatrix))
+            if exudyn.ComputeItemType.ODE2LHS in applies:
+                lhs[ltg] += np.asarray(mbs.ComputeItem(index, exudyn.ComputeItemType.ODE2LHS), dtype=float)
+    except Exception as exc:  # a user function that raises at the initial state
+        message = " ".join(str(exc).split())
+        raise SimulationError(f"evaluating the forces at t = 0 failed: {message[:500]}") from exc
+    accelerations = np.linalg.solve(mass, -lhs)
+    return {body: float(accelerations[data.GetNodeLTGODE2(node)[0]]) for body, node in assembly.nodes.items()}
+
+
 def _stored(assembly: Assembly, name: str) -> np.ndarray:
     return np.asarray(assembly.mbs.GetSensorStoredData(assembly.sensors[name]), dtype=float)
 
 
-def _collect(assembly: Assembly, end_time: float, settings: SolverSettings) -> tuple[Samples, np.ndarray | None]:
+def _collect(assembly: Assembly, end_time: float, settings: SolverSettings,
+             initial_accelerations: dict[str, float] | None = None) -> tuple[Samples, np.ndarray | None]:
     """Read the sensors into :class:`Samples`; raise SimulationError for NaN/inf or missing output."""
     columns = {name: _stored(assembly, name) for name in assembly.sensors}
+    for body, value in (initial_accelerations or {}).items():
+        data = columns[f"{body}_acceleration"]
+        if len(data) and data[0, 0] == 0.0:
+            data[0, 1] = value  # Exudyn records 0 at t = 0 (see _initial_accelerations)
     time = columns["barrel_position"][:, 0]
     if len(time) < 2:
         raise SimulationError(f"Exudyn {settings.solver} produced fewer than two output samples")
@@ -146,9 +179,10 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
     assembly = assemble(scene, settings.user_functions)
     t_assembled = _time.perf_counter()
     try:
+        initial_accelerations = _initial_accelerations(assembly)
         steps = _solve(assembly, settings, float(end_time))
         t_solved = _time.perf_counter()
-        samples, contact_force = _collect(assembly, float(end_time), settings)
+        samples, contact_force = _collect(assembly, float(end_time), settings, initial_accelerations)
     finally:
         assembly.close()
     metrics = analyse(scene, samples, contact_force, float(impact_threshold))
