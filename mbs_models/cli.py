@@ -75,6 +75,18 @@ def _cmd_paper(args) -> int:
     return EXIT_OK
 
 
+def _cmd_validate(args) -> int:
+    from validation.compare import compare
+
+    scene = _resolve_scene(args.scene)
+    comparison = compare(scene, args.end_time, args.accuracy, impact_threshold=args.impact_threshold)
+    if args.json:
+        print(json.dumps(comparison.to_dict(), indent=2, allow_nan=False))
+    else:
+        print(comparison.table())
+    return EXIT_OK if comparison.passed else EXIT_FAILED
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="recoil", description="Recoil mechanisms with impact absorbers (Exudyn).")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
@@ -90,6 +102,15 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--impact-threshold", type=float, default=1000.0,
                      help="peak force (N) above which a contact episode counts as an impact (default 1000)")
     run.set_defaults(handler=_cmd_run)
+
+    validate = sub.add_parser("validate", help="engine vs the independent scipy reference for one scene "
+                                               "(exit code 1 if a tolerance is exceeded)")
+    validate.add_argument("scene", help="scene TOML file (or a shipped scene: simplified, model_i, model_ii)")
+    validate.add_argument("--end-time", type=float, default=10.0, help="simulated time in s (default 10)")
+    validate.add_argument("--accuracy", default="standard", choices=("draft", "standard", "reference"))
+    validate.add_argument("--impact-threshold", type=float, default=1000.0, help="impact threshold in N")
+    validate.add_argument("--json", action="store_true", help="print the comparison as JSON")
+    validate.set_defaults(handler=_cmd_validate)
 
     paper = sub.add_parser("paper", help="reproduce the paper: Table 2 and the figures")
     paper.add_argument("--out", default="out", help="output directory (default ./out)")

@@ -1,0 +1,111 @@
+"""Parameter sweeps: many scenes, in parallel worker processes, with progress.
+
+Exudyn models cannot be pickled, so workers receive *scenes* (frozen dataclasses) and send back
+the scalar metrics of each run (:class:`SweepPoint`), never models or arrays.
+
+    from mbs_models import model_i
+    from mbs_models.sweep import gap_sweep
+    points = gap_sweep(model_i, absorber_mass=500.0, gaps=[0.0, 0.01, 0.02])
+"""
+
+from __future__ import annotations
+
+import math
+import multiprocessing
+import os
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass
+from typing import Callable, Iterable, Sequence
+
+from .accuracy import SolverSettings
+from .errors import SceneError, SimulationError
+from .scene import Scene
+
+Progress = Callable[[int, int], None]
+
+
+@dataclass(frozen=True)
+class SweepPoint:
+    """Scalar results of one scene of a sweep (SI units); ``error`` is set if its solve failed."""
+
+    scene: Scene
+    max_barrel_displacement: float | None
+    time_of_max_barrel_displacement: float | None
+    peak_contact_force: float | None
+    max_absorber_velocity: float | None
+    impacts: int | None
+    wall_time: float
+    error: str | None = None
+
+    @property
+    def gap(self) -> float | None:
+        """The scene's contact gap in m (None without an absorber)."""
+        return self.scene.contact.gap if self.scene.contact is not None else None
+
+
+def _run_one(job: tuple[Scene, float, str | SolverSettings]) -> SweepPoint:
+    from .simulate import simulate
+
+    scene, end_time, accuracy = job
+    try:
+        result = simulate(scene, end_time, accuracy)
+    except SimulationError as exc:
+        return SweepPoint(scene, None, None, None, None, None, 0.0, error=str(exc))
+    return SweepPoint(scene, result.max_barrel_displacement, result.time_of_max_barrel_displacement,
+                      result.peak_contact_force, result.max_absorber_velocity, len(result.impacts),
+                      result.wall_time)
+
+
+def default_workers() -> int:
+    """Worker processes to use: the CPUs available to this process."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # pragma: no cover - not Linux
+        return max(1, os.cpu_count() or 1)
+
+
+def run_sweep(scenes: Sequence[Scene], end_time: float = 10.0, accuracy: str | SolverSettings = "standard", *,
+              workers: int | None = None, progress: Progress | None = None) -> list[SweepPoint]:
+    """Simulate every scene (in order) and return one :class:`SweepPoint` each.
+
+    ``workers=1`` runs in this process; otherwise a process pool of ``workers`` (default: all CPUs)
+    is used.  A failed solve does not stop the sweep: its point carries ``error`` instead of values.
+    """
+    scenes = list(scenes)
+    if not all(isinstance(s, Scene) for s in scenes):
+        raise SceneError("scenes", "every item of a sweep must be a Scene")
+    workers = default_workers() if workers is None else workers
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise SceneError("workers", f"must be a whole number >= 1, got {workers!r}")
+    jobs = [(scene, end_time, accuracy) for scene in scenes]
+    if not jobs:
+        return []
+    # validate the shared arguments once, in this process, so that bad input fails fast
+    from .simulate import _check_arguments
+    from .accuracy import solver_settings_for
+    _check_arguments(scenes[0], end_time, 0.0)
+    solver_settings_for(accuracy)
+
+    points: list[SweepPoint] = []
+    if workers == 1 or len(jobs) == 1:
+        for i, job in enumerate(jobs):
+            points.append(_run_one(job))
+            if progress:
+                progress(i + 1, len(jobs))
+        return points
+    chunk = max(1, math.ceil(len(jobs) / (workers * 8)))
+    context = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn")
+    with ProcessPoolExecutor(max_workers=min(workers, len(jobs)), mp_context=context) as pool:
+        for i, point in enumerate(pool.map(_run_one, jobs, chunksize=chunk)):
+            points.append(point)
+            if progress and ((i + 1) % max(1, len(jobs) // 20) == 0 or i + 1 == len(jobs)):
+                progress(i + 1, len(jobs))
+    return points
+
+
+def gap_sweep(factory: Callable[..., Scene], absorber_mass: float, gaps: Iterable[float], end_time: float = 10.0,
+              accuracy: str | SolverSettings = "standard", *, workers: int | None = None,
+              progress: Progress | None = None) -> list[SweepPoint]:
+    """Max barrel displacement etc. over gaps (m) for one model factory and absorber mass (Figs 4-5)."""
+    scenes = [factory(absorber_mass, float(gap)) for gap in gaps]
+    return run_sweep(scenes, end_time, accuracy, workers=workers, progress=progress)

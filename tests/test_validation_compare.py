@@ -1,0 +1,72 @@
+"""Engine vs independent reference on the 19 paper cases, and `recoil validate`."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from mbs_models import model_i, model_ii, simplified_model
+from mbs_models.cli import main
+from validation.compare import DEFAULT_TOLERANCES, QuantityCheck, compare
+
+PAPER_CASES = [("simplified", simplified_model, None, None)] + [
+    (f"{label}-m{mass:g}-gap{gap * 1000:g}mm", factory, mass, gap)
+    for label, factory in (("model-i", model_i), ("model-ii", model_ii))
+    for mass in (100.0, 500.0, 1000.0)
+    for gap in (0.0, 0.04, 0.08)
+]
+
+
+def test_there_are_19_paper_cases():
+    assert len(PAPER_CASES) == 19
+
+
+@pytest.mark.parametrize("case", PAPER_CASES, ids=[c[0] for c in PAPER_CASES])
+def test_engine_agrees_with_reference_on_paper_case(case):
+    _, factory, mass, gap = case
+    scene = factory() if mass is None else factory(mass, gap)
+    comparison = compare(scene, 10.0, "standard")
+    assert comparison.check("max_barrel_displacement").relative_error <= 1e-4
+    if scene.has_absorber:
+        assert comparison.check("peak_contact_force").relative_error <= 1e-3
+        assert comparison.check("max_absorber_velocity").relative_error <= 1e-3
+    assert comparison.impacts_match, (comparison.engine_impacts, comparison.reference_impacts)
+    assert comparison.passed, comparison.table()
+
+
+def test_quantity_check_verdicts():
+    assert QuantityCheck("x", 1.0, 1.0, 0.0, 1e-4).passed
+    assert not QuantityCheck("x", 1.1, 1.0, 0.1, 1e-4).passed
+    assert QuantityCheck("x", None, None, None, 1e-4).passed  # absent in this scene
+    assert not QuantityCheck("x", 1.0, None, None, 1e-4).passed  # present in one only
+
+
+def test_a_too_tight_tolerance_fails_the_comparison():
+    comparison = compare(model_ii(1000.0, 0.0), 1.0, "draft",
+                         tolerances={"max_barrel_displacement": 1e-15})
+    assert not comparison.passed
+    assert "max_barrel_displacement" in comparison.failures
+
+
+def test_validate_cli_prints_table_and_exit_code(capsys):
+    assert main(["validate", "model_ii", "--end-time", "1"]) == 0
+    out = capsys.readouterr().out
+    assert "max_barrel_displacement" in out and "PASSED" in out
+    assert main(["validate", "simplified", "--end-time", "1", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["passed"] is True and data["checks"]
+
+
+def test_validate_cli_exit_1_on_exceeded_tolerance(capsys, monkeypatch):
+    import validation.compare as compare_module
+    monkeypatch.setitem(compare_module.DEFAULT_TOLERANCES, "max_barrel_displacement", 0.0)
+    assert main(["validate", "model_ii", "--end-time", "0.5", "--accuracy", "draft"]) == 1
+    assert "FAILED" in capsys.readouterr().out
+    assert DEFAULT_TOLERANCES["max_barrel_displacement"] == 0.0  # the patch was effective
+
+
+def test_validate_bad_scene_is_exit_2(tmp_path, capsys):
+    path = tmp_path / "s.toml"
+    path.write_text("[barrel]\nmass = -1\n")
+    assert main(["validate", str(path)]) == 2

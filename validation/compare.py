@@ -1,0 +1,161 @@
+"""Engine vs reference on any scene: relative errors of the metrics, errors of the time histories.
+
+The engine is :func:`mbs_models.simulate` (Exudyn); the reference is :func:`validation.reference.solve_reference`
+(scipy, event-driven, tight tolerances).  :func:`compare` runs both and judges each quantity against
+a stated tolerance; :attr:`Comparison.passed` is the verdict ``recoil validate`` turns into its exit code.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from mbs_models import simulate
+from mbs_models.accuracy import SolverSettings
+from mbs_models.peaks import HermiteTrajectory
+from mbs_models.result import Result
+from mbs_models.scene import Scene
+
+from .reference import solve_reference
+from .result import ReferenceResult
+
+#: Relative tolerances of the metrics at the ``standard`` preset (validation issue).
+DEFAULT_TOLERANCES = {
+    "max_barrel_displacement": 1e-4,
+    "time_of_max_barrel_displacement": 1e-3,
+    "peak_contact_force": 1e-3,
+    "max_absorber_velocity": 1e-3,
+    "time_of_max_absorber_velocity": 1e-2,
+    # max error of the time history on a common grid, relative to the history's largest magnitude
+    "barrel_position_history": 1e-3,
+    "absorber_position_history": 1e-3,
+}
+
+
+@dataclass(frozen=True)
+class QuantityCheck:
+    """One compared quantity: engine and reference values, relative error, tolerance, verdict."""
+
+    name: str
+    engine: float | None
+    reference: float | None
+    relative_error: float | None
+    tolerance: float
+
+    @property
+    def passed(self) -> bool:
+        if self.relative_error is None and self.engine is None and self.reference is None:
+            return True  # the quantity does not exist in this scene (e.g. no absorber)
+        return self.relative_error is not None and self.relative_error <= self.tolerance
+
+    def to_dict(self) -> dict:
+        return {"name": self.name, "engine": self.engine, "reference": self.reference,
+                "relative_error": self.relative_error, "tolerance": self.tolerance, "passed": self.passed}
+
+
+@dataclass
+class Comparison:
+    """Result of :func:`compare` for one scene."""
+
+    scene: Scene
+    end_time: float
+    accuracy: str
+    checks: list[QuantityCheck]
+    engine_impacts: int
+    reference_impacts: int
+    engine: Result = field(repr=False)
+    reference: ReferenceResult = field(repr=False)
+
+    @property
+    def impacts_match(self) -> bool:
+        """Same number of impacts (contact episodes above the threshold) in both."""
+        return self.engine_impacts == self.reference_impacts
+
+    @property
+    def passed(self) -> bool:
+        return self.impacts_match and all(check.passed for check in self.checks)
+
+    @property
+    def failures(self) -> list[str]:
+        out = [c.name for c in self.checks if not c.passed]
+        if not self.impacts_match:
+            out.append(f"impacts ({self.engine_impacts} vs {self.reference_impacts})")
+        return out
+
+    def check(self, name: str) -> QuantityCheck:
+        return next(c for c in self.checks if c.name == name)
+
+    def to_dict(self) -> dict:
+        return {"scene": self.scene.name, "end_time": self.end_time, "accuracy": self.accuracy,
+                "passed": self.passed, "engine_impacts": self.engine_impacts,
+                "reference_impacts": self.reference_impacts, "checks": [c.to_dict() for c in self.checks]}
+
+    def table(self) -> str:
+        """A small text table (used by ``recoil validate``)."""
+        lines = [f"{self.scene.name}: engine ({self.accuracy}) vs reference, {self.end_time:g} s",
+                 f"{'quantity':34s} {'engine':>14s} {'reference':>14s} {'rel. error':>11s} {'tolerance':>9s}  ok"]
+        for c in self.checks:
+            if c.engine is None and c.reference is None and c.relative_error is None:
+                continue
+            fmt = lambda v: "-" if v is None else f"{v:14.7g}"  # noqa: E731
+            err = "-" if c.relative_error is None else f"{c.relative_error:11.2e}"
+            lines.append(f"{c.name:34s} {fmt(c.engine):>14s} {fmt(c.reference):>14s} {err:>11s} "
+                         f"{c.tolerance:9.0e}  {'yes' if c.passed else 'NO'}")
+        lines.append(f"{'impacts (> threshold)':34s} {self.engine_impacts:14d} {self.reference_impacts:14d} "
+                     f"{'':11s} {'equal':>9s}  {'yes' if self.impacts_match else 'NO'}")
+        lines.append("PASSED" if self.passed else f"FAILED: {', '.join(self.failures)}")
+        return "\n".join(lines)
+
+
+def _relative(engine, reference) -> float | None:
+    if engine is None or reference is None:
+        return None
+    scale = abs(reference)
+    if scale == 0.0:
+        return abs(engine - reference)
+    return abs(engine - reference) / scale
+
+
+def history_error(engine: Result, reference: ReferenceResult, quantity: str, points: int = 4001) -> float | None:
+    """Max |engine - reference| of a position history on a uniform grid, relative to max |reference|.
+
+    The engine's step-end samples are interpolated with cubic Hermite polynomials (position and
+    velocity), the reference uses its dense output.
+    """
+    position = getattr(engine, f"{quantity}_position")
+    if position is None:
+        return None
+    velocity = getattr(engine, f"{quantity}_velocity")
+    grid = np.linspace(0.0, engine.end_time, points)
+    ours = HermiteTrajectory(engine.time, position, velocity)(grid)
+    theirs = np.asarray(getattr(reference, f"{quantity}_position")(grid), dtype=float)
+    scale = float(np.max(np.abs(theirs)))
+    return float(np.max(np.abs(ours - theirs)) / scale) if scale > 0 else float(np.max(np.abs(ours - theirs)))
+
+
+def compare_results(engine: Result, reference: ReferenceResult, tolerances: dict[str, float] | None = None,
+                    accuracy: str = "standard") -> Comparison:
+    """Judge an engine result against a reference result of the same scene."""
+    tolerances = {**DEFAULT_TOLERANCES, **(tolerances or {})}
+    checks = []
+    for name in ("max_barrel_displacement", "time_of_max_barrel_displacement", "peak_contact_force",
+                 "max_absorber_velocity", "time_of_max_absorber_velocity"):
+        ours, theirs = getattr(engine, name), getattr(reference, name)
+        checks.append(QuantityCheck(name, ours, theirs, _relative(ours, theirs), tolerances[name]))
+    for body in ("barrel", "absorber"):
+        error = history_error(engine, reference, body)
+        checks.append(QuantityCheck(f"{body}_position_history", None, None, error,
+                                    tolerances[f"{body}_position_history"]))
+    return Comparison(scene=engine.scene, end_time=engine.end_time, accuracy=accuracy, checks=checks,
+                      engine_impacts=len(engine.impacts), reference_impacts=len(reference.impacts),
+                      engine=engine, reference=reference)
+
+
+def compare(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSettings = "standard",
+            tolerances: dict[str, float] | None = None, impact_threshold: float = 1000.0) -> Comparison:
+    """Run the engine and the reference on ``scene`` and compare them (see :data:`DEFAULT_TOLERANCES`)."""
+    engine = simulate(scene, end_time, accuracy, impact_threshold=impact_threshold)
+    reference = solve_reference(scene, end_time, impact_threshold=impact_threshold)
+    label = accuracy if isinstance(accuracy, str) else accuracy.label()
+    return compare_results(engine, reference, tolerances, label)
