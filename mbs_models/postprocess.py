@@ -125,7 +125,7 @@ def energies(scene: Scene, s: Samples, interp: _Interpolant) -> tuple[dict[str, 
             return contact_force_at(scene, interp, x) * relative_velocity
         relative_position = s.barrel_position - s.absorber_position
         elastic = forces.contact_elastic_energy(relative_position, scene.contact, scene.conventions)
-        dissipated["contact"] = _cumulative_quadrature(t, contact_power) - elastic
+        dissipated["contact"] = _cumulative_quadrature(t, contact_power) - (elastic - elastic[0])  # 0 at t = 0
         kinetic = kinetic + 0.5 * absorber.mass * s.absorber_velocity ** 2
         spring_extension = absorber_relative(s.barrel_position, s.absorber_position)
         stored = stored + 0.5 * absorber.stiffness * spring_extension ** 2 + elastic
