@@ -15,13 +15,15 @@ import multiprocessing
 import os
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
-from typing import Callable, Iterable, Sequence
+from typing import Callable, Iterable, Sequence, TypeVar
 
 from .accuracy import SolverSettings
 from .errors import SceneError, SimulationError
 from .scene import Scene
 
 Progress = Callable[[int, int], None]
+T = TypeVar("T")
+R = TypeVar("R")
 
 
 @dataclass(frozen=True)
@@ -74,9 +76,6 @@ def run_sweep(scenes: Sequence[Scene], end_time: float = 10.0, accuracy: str | S
     scenes = list(scenes)
     if not all(isinstance(s, Scene) for s in scenes):
         raise SceneError("scenes", "every item of a sweep must be a Scene")
-    workers = default_workers() if workers is None else workers
-    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
-        raise SceneError("workers", f"must be a whole number >= 1, got {workers!r}")
     jobs = [(scene, end_time, accuracy) for scene in scenes]
     if not jobs:
         return []
@@ -86,21 +85,35 @@ def run_sweep(scenes: Sequence[Scene], end_time: float = 10.0, accuracy: str | S
     _check_arguments(scenes[0], end_time, 0.0)
     solver_settings_for(accuracy)
 
-    points: list[SweepPoint] = []
-    if workers == 1 or len(jobs) == 1:
-        for i, job in enumerate(jobs):
-            points.append(_run_one(job))
+    return parallel_map(_run_one, jobs, workers=workers, progress=progress)
+
+
+def parallel_map(function: Callable[[T], R], items: Sequence[T], *, workers: int | None = None,
+                 progress: Progress | None = None) -> list[R]:
+    """``[function(item) for item in items]`` in worker processes, in order, with progress calls.
+
+    ``function`` must be a module-level function and items picklable (scenes are; Exudyn models
+    are not).  ``workers=1`` (or a single item) runs in this process.
+    """
+    items = list(items)
+    workers = default_workers() if workers is None else workers
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise SceneError("workers", f"must be a whole number >= 1, got {workers!r}")
+    out: list[R] = []
+    if workers == 1 or len(items) <= 1:
+        for i, item in enumerate(items):
+            out.append(function(item))
             if progress:
-                progress(i + 1, len(jobs))
-        return points
-    chunk = max(1, math.ceil(len(jobs) / (workers * 8)))
+                progress(i + 1, len(items))
+        return out
+    chunk = max(1, math.ceil(len(items) / (workers * 8)))
     context = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn")
-    with ProcessPoolExecutor(max_workers=min(workers, len(jobs)), mp_context=context) as pool:
-        for i, point in enumerate(pool.map(_run_one, jobs, chunksize=chunk)):
-            points.append(point)
-            if progress and ((i + 1) % max(1, len(jobs) // 20) == 0 or i + 1 == len(jobs)):
-                progress(i + 1, len(jobs))
-    return points
+    with ProcessPoolExecutor(max_workers=min(workers, len(items)), mp_context=context) as pool:
+        for i, value in enumerate(pool.map(function, items, chunksize=chunk)):
+            out.append(value)
+            if progress and ((i + 1) % max(1, len(items) // 20) == 0 or i + 1 == len(items)):
+                progress(i + 1, len(items))
+    return out
 
 
 def gap_sweep(factory: Callable[..., Scene], absorber_mass: float, gaps: Iterable[float], end_time: float = 10.0,
