@@ -27,6 +27,9 @@ FIXED_STEP_SOLVERS = ("RK44", "RK67", "RK33", "ExplicitEuler", "ExplicitMidpoint
 #: Implicit solvers among them (Newton iterations each step).
 IMPLICIT_SOLVERS = ("GeneralizedAlpha", "TrapezoidalIndex2")
 SOLVERS = ADAPTIVE_SOLVERS + FIXED_STEP_SOLVERS
+#: Tightest tolerances accepted: double precision cannot meet tighter ones and the solver stalls.
+MIN_RELATIVE_TOLERANCE = 1e-13
+MIN_ABSOLUTE_TOLERANCE = 1e-20
 USER_FUNCTION_BACKENDS = ("symbolic", "python")
 
 
@@ -57,8 +60,9 @@ class SolverSettings:
             raise SceneError("user_functions", f"must be one of {', '.join(USER_FUNCTION_BACKENDS)}, "
                                                f"got {self.user_functions!r}")
         if self.adaptive:
-            for key in ("relative_tolerance", "absolute_tolerance"):
-                _positive(key, getattr(self, key), upper=1.0)
+            # below these Exudyn's DOPRI5 stalls at round-off (measured: rtol 1e-14 or atol 1e-60 never end)
+            _positive("relative_tolerance", self.relative_tolerance, upper=1.0, lower=MIN_RELATIVE_TOLERANCE)
+            _positive("absolute_tolerance", self.absolute_tolerance, upper=1.0, lower=MIN_ABSOLUTE_TOLERANCE)
             _positive("max_step", self.max_step, upper=10.0)
         else:
             _positive("step", self.step, upper=1.0)
@@ -80,11 +84,12 @@ class SolverSettings:
         return f"{self.solver} h={self.step:g} s ({self.user_functions})"
 
 
-def _positive(key: str, value, upper: float) -> None:
+def _positive(key: str, value, upper: float, lower: float = 0.0) -> None:
+    interval = f"[{lower:g}, {upper:g}]" if lower > 0 else f"(0, {upper:g}]"
     if value is None or isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise SceneError(key, f"must be a number in (0, {upper:g}], got {value!r}")
-    if not math.isfinite(value) or value <= 0 or value > upper:
-        raise SceneError(key, f"must be in (0, {upper:g}], got {value!r}")
+        raise SceneError(key, f"must be a number in {interval}, got {value!r}")
+    if not math.isfinite(value) or value <= 0 or value < lower or value > upper:
+        raise SceneError(key, f"must be in {interval}, got {value!r}")
 
 
 #: Accuracy presets.  All use adaptive DOPRI5 with symbolic user functions; see the README's table

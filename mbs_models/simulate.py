@@ -9,6 +9,11 @@ Contract
   :class:`~mbs_models.errors.SimulationError` is raised: a solver that fails, stops before
   ``end_time``, or produces NaN/inf never yields a result.  Bad arguments raise
   :class:`~mbs_models.errors.SceneError` naming the argument.
+* Numerical safety (:mod:`mbs_models.stability`): a fixed step that is unstable for the scene or
+  would step over an impact is refused before solving (SceneError, key ``step``, with the safe
+  limit); an adaptive solver that stepped over a whole (grazing) contact is re-run with a smaller
+  ``max_step`` (the result's ``settings`` say which); a solve whose energy balance is off by more
+  than 10 % of the initial energy raises SimulationError.
 * The Exudyn model is released after every run (no growth over thousands of runs).
 """
 
@@ -16,10 +21,12 @@ from __future__ import annotations
 
 import math
 import time as _time
+from dataclasses import replace
 
 import exudyn
 import numpy as np
 
+from . import stability
 from .accuracy import SolverSettings, solver_settings_for
 from .assembly import Assembly, assemble
 from .errors import SceneError, SimulationError
@@ -29,6 +36,8 @@ from .scene import Scene
 
 #: Longest simulated time accepted, in s.
 MAX_END_TIME = 1.0e4
+#: Re-solves (with max_step / 4 each) when an adaptive solver stepped over a whole contact.
+MAX_CONTACT_RETRIES = 3
 #: Most output samples kept for fixed-step solvers (output is thinned beyond this).
 MAX_FIXED_STEP_SAMPLES = 1_000_000
 
@@ -156,6 +165,33 @@ def _collect(assembly: Assembly, end_time: float, settings: SolverSettings,
     return samples, values.get("contact_force")
 
 
+def _settings_after_stepped_over_contacts(scene: Scene, samples: Samples, contact_force: np.ndarray | None,
+                                          settings: SolverSettings, impact_threshold: float,
+                                          attempt: int) -> SolverSettings | None:
+    """None if the solver felt every contact; else settings for a re-solve with a smaller max_step.
+
+    A fixed-step solver, or an adaptive one still stepping over contacts after
+    :data:`MAX_CONTACT_RETRIES` re-solves, raises SimulationError (see :mod:`mbs_models.stability`).
+    """
+    if contact_force is None:
+        return None
+    missed = stability.stepped_over_contacts(
+        scene, samples.time, samples.barrel_position - samples.absorber_position,
+        samples.barrel_velocity - samples.absorber_velocity, contact_force, impact_threshold)
+    if not missed:
+        return None
+    first = missed[0]
+    shortest = min(m.duration for m in missed)
+    what = (f"Exudyn {settings.solver} stepped over {len(missed)} contact(s) between two steps, the first at "
+            f"t = {first.time:.6g} s (penetration {first.penetration:.3g} m, ~{first.peak_force:.3g} N, "
+            f"lasting ~{first.duration:.3g} s)")
+    if not settings.adaptive:
+        raise SimulationError(f"{what}; use step <= {shortest / stability.STEPS_PER_CONTACT:.3g} s")
+    if attempt >= MAX_CONTACT_RETRIES:
+        raise SimulationError(f"{what} even with max_step = {settings.max_step:.3g} s")
+    return replace(settings, max_step=min(settings.max_step, shortest) / 4.0)
+
+
 def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSettings = "standard", *,
              user_functions: str | None = None, impact_threshold: float = 1000.0) -> Result:
     """Simulate ``scene`` from t = 0 to ``end_time`` (s) with Exudyn and return a :class:`Result`.
@@ -170,28 +206,45 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
 
     Raises
     ------
-    SceneError: an argument is invalid (the message names it).
-    SimulationError: the solve failed, stopped early or produced non-finite values.
+    SceneError: an argument is invalid, or a fixed step is unsafe for the scene (the message names it
+        and gives the safe limit).
+    SimulationError: the solve failed, stopped early, produced non-finite values, stepped over a
+        contact with a fixed step, or does not balance energy (see :mod:`mbs_models.stability`).
+
+    Warns
+    -----
+    stability.AccuracyWarning: a fixed step resolves impacts with fewer than 10 steps, or the energy
+        balance is off by more than 1 % of the initial energy.
     """
     _check_arguments(scene, end_time, impact_threshold)
     settings = solver_settings_for(accuracy, user_functions)
+    stability.check_settings(scene, settings, float(end_time))  # unsafe steps: SceneError before solving
     t_start = _time.perf_counter()
-    assembly = assemble(scene, settings.user_functions)
-    t_assembled = _time.perf_counter()
-    try:
-        initial_accelerations = _initial_accelerations(assembly)
-        steps = _solve(assembly, settings, float(end_time))
-        t_solved = _time.perf_counter()
-        samples, contact_force = _collect(assembly, float(end_time), settings, initial_accelerations)
-    finally:
-        assembly.close()
+    for attempt in range(MAX_CONTACT_RETRIES + 1):
+        assembly = assemble(scene, settings.user_functions)
+        t_assembled = _time.perf_counter()
+        try:
+            initial_accelerations = _initial_accelerations(assembly)
+            steps = _solve(assembly, settings, float(end_time))
+            t_solved = _time.perf_counter()
+            samples, contact_force = _collect(assembly, float(end_time), settings, initial_accelerations)
+        finally:
+            assembly.close()
+        retry = _settings_after_stepped_over_contacts(scene, samples, contact_force, settings,
+                                                      float(impact_threshold), attempt)
+        if retry is None:
+            break
+        settings = retry
     metrics = analyse(scene, samples, contact_force, float(impact_threshold))
     for name in ("max_barrel_displacement", "max_absorber_velocity", "peak_contact_force"):
         value = getattr(metrics, name)
         if value is not None and not math.isfinite(value):
             raise SimulationError(f"post-processing produced a non-finite {name.replace('_', ' ')}")
-    t_end = _time.perf_counter()
     dissipated_history = metrics.dissipated_energy_history
+    energy_error = (metrics.kinetic_energy_history + metrics.stored_energy_history + sum(dissipated_history.values())
+                    - stability.initial_energy(scene))
+    stability.check_energy_balance(scene, samples.time, energy_error, f"Exudyn {settings.label()}")
+    t_end = _time.perf_counter()
     return Result(
         scene=scene, settings=settings, end_time=float(end_time), time=samples.time,
         barrel_position=samples.barrel_position, barrel_velocity=samples.barrel_velocity,
