@@ -64,14 +64,19 @@ def _cmd_run(args) -> int:
 
 
 def _cmd_paper(args) -> int:
-    from validation.replication import table2_markdown, write_paper_outputs
+    from validation.report import ReportOptions, table2_markdown, table2_rows, write_report
 
-    start = time.perf_counter()
-    written = write_paper_outputs(args.out, accuracy=args.accuracy, end_time=args.end_time, progress=_progress)
-    print(table2_markdown(written["table2"]))
-    count = sum(len(paths) for paths in written["figures"].values())
-    print(f"wrote table2.md, table2.json and {count} figures to {written['out']} "
-          f"in {time.perf_counter() - start:.1f} s")
+    if args.workers is not None and args.workers < 1:
+        raise SceneError("--workers", f"must be >= 1, got {args.workers}")
+    options = ReportOptions.reduced(workers=args.workers) if args.quick else ReportOptions(workers=args.workers)
+    data = write_report(args.out, options, progress=_progress)
+    print(table2_markdown(table2_rows(data)))
+    failed = [c["scene"] for c in data["comparisons"] if not c["passed"]]
+    print(f"wrote report.html, results.json, table2.md/json and the figures to {args.out} "
+          f"in {data['timings']['total']:.1f} s")
+    if failed:
+        print(f"engine vs reference FAILED for: {', '.join(failed)}", file=sys.stderr)
+        return EXIT_FAILED
     return EXIT_OK
 
 
@@ -114,8 +119,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     paper = sub.add_parser("paper", help="reproduce the paper: Table 2 and the figures")
     paper.add_argument("--out", default="out", help="output directory (default ./out)")
-    paper.add_argument("--accuracy", default="standard", choices=("draft", "standard", "reference"))
-    paper.add_argument("--end-time", type=float, default=10.0, help="simulated time in s (default 10)")
+    paper.add_argument("--quick", action="store_true",
+                       help="a reduced but complete report (coarse gap sweeps, two readings of the paper)")
+    paper.add_argument("--workers", type=int, default=None, help="worker processes (default: all CPUs)")
     paper.set_defaults(handler=_cmd_paper)
     return parser
 

@@ -1,0 +1,31 @@
+"""The README's numbers are the library's numbers (Table 2 is recomputed and compared)."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+from mbs_models import model_i, model_ii, simplified_model, simulate
+
+README = Path(__file__).resolve().parent.parent / "README.md"
+_ROW = re.compile(r"^\| (simplified|model \(i\)|model \(ii\)) \| (any|\d+) \| (0\.\d{4}) \| (0\.\d{4}) \| ([+−-]\d+\.\d+) \|$")
+
+
+def _readme_table2():
+    rows = [m.groups() for line in README.read_text().splitlines() if (m := _ROW.match(line))]
+    assert len(rows) == 7, "README Table 2 must list the simplified model and 3 masses of each model"
+    return rows
+
+
+@pytest.mark.parametrize("row", _readme_table2(), ids=lambda r: f"{r[0]}-{r[1]}")
+def test_readme_table2_matches_the_engine(row):
+    model, mass, ours, paper, difference_mm = row
+    if model == "simplified":
+        scene = simplified_model()
+    else:
+        scene = (model_i if model == "model (i)" else model_ii)(float(mass), 0.0)
+    x_max = simulate(scene, 10.0).max_barrel_displacement
+    assert f"{x_max:.4f}" == ours
+    assert float(difference_mm.replace("−", "-")) == pytest.approx((x_max - float(paper)) * 1e3, abs=0.006)

@@ -1,0 +1,562 @@
+"""The replication report: ``recoil paper --out DIR`` writes ``report.html`` and ``results.json``.
+
+One self-contained HTML file (figures embedded as PNG data) for a reviewer of the replication:
+the models and their equations, parameters, Table 2 (ours, paper, difference), the gap sweeps
+(Figs 4-5), time histories (Figs 6-8), contact force and absorber velocity (Figs 9-11),
+engine-vs-reference errors for every case shown, the convention study, the contact-law
+calibration, the paper's qualitative claims checked, and a plain list of every published number we
+cannot reproduce with its most likely reason.  PNG files, ``table2.md`` and ``table2.json`` are
+written beside it.  Everything is written under a temporary name and renamed.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import json
+import math
+import time
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from mbs_models import model_i, model_ii, simplified_model, simulate
+from mbs_models.models import model_i as _model_i_doc, model_ii as _model_ii_doc, simplified_model as _simp_doc
+from mbs_models.outputs import atomic_write_json, atomic_write_text, prepare_output_dir
+from mbs_models.plotting import (MODEL_COLOURS, figure_png, new_figure, plot_barrel_displacements,
+                                 plot_contact_histories, plot_first_impact)
+from mbs_models.scene import Scene
+from mbs_models.sweep import parallel_map, run_sweep
+
+from .claims import ClaimEvidence, evaluate_claims
+from .compare import compare
+from .conventions import CONVENTION_CASES, TREND_GAPS, study_conventions
+from .paper import MODEL_I, MODEL_II, SIMPLIFIED, TABLE2_MASSES, published, published_values, table2
+
+Progress = Callable[[str], None]
+#: A published number counts as reproduced when ours is within this relative difference.
+REPRODUCED_WITHIN = 0.01
+
+
+def _silent(message: str) -> None:
+    pass
+
+
+@dataclass(frozen=True)
+class ReportOptions:
+    """What the report computes.  The defaults are the full study; tests use :meth:`reduced`."""
+
+    gap_step: float = 0.001                  # m, the sweeps of Figs 4-5 (0 to 120 mm)
+    gap_max: float = 0.12                    # m
+    masses: tuple[float, ...] = TABLE2_MASSES
+    comparison_gaps: tuple[float, ...] = (0.0, 0.04, 0.08)
+    convention_labels: tuple[str, ...] | None = None   # None: every reading
+    calibration_parameters: tuple[str, ...] = ("stiffness", "exponent", "damping_factor")
+    calibration_bounds: dict = field(default_factory=lambda: {"exponent": (0.5, 2.5)})
+    accuracy: str = "standard"
+    end_time: float = 10.0
+    workers: int | None = None
+
+    @classmethod
+    def reduced(cls, **changes) -> "ReportOptions":
+        """A small but complete report (every section and figure) for tests."""
+        base = dict(gap_step=0.02, comparison_gaps=(0.0,), convention_labels=("default (DESIGN.md)",
+                                                                                     "literal_gap_sign"),
+                    calibration_parameters=("stiffness", "damping_factor"), calibration_bounds={})
+        base.update(changes)
+        return cls(**base)
+
+
+# --------------------------------------------------------------------------------------------- compute
+def _comparison_job(scene: Scene) -> dict:
+    comparison = compare(scene, 10.0, "standard")
+    data = comparison.to_dict()
+    data["model"] = scene.model_label
+    data["absorber_mass"] = scene.absorber.mass if scene.absorber else None
+    data["gap"] = scene.contact.gap if scene.contact else None
+    return data
+
+
+def _comparison_scenes(options: ReportOptions) -> list[Scene]:
+    scenes = [simplified_model()]
+    for factory in (model_i, model_ii):
+        scenes += [factory(m, g) for m in options.masses for g in options.comparison_gaps]
+    return scenes
+
+
+def compute_report(options: ReportOptions = ReportOptions(), progress: Progress = _silent) -> dict:
+    """Run every computation of the report; return a dict of results (figures are made later)."""
+    timings: dict[str, float] = {}
+    data: dict = {"options": {k: v for k, v in options.__dict__.items()}}
+
+    start = time.perf_counter()
+    progress("engine vs reference on the paper cases")
+    scenes = _comparison_scenes(options)
+    if options.comparison_gaps == (0.0, 0.04, 0.08) and options.masses == TABLE2_MASSES:
+        assert len(scenes) == 19
+    data["comparisons"] = parallel_map(_comparison_job, scenes, workers=options.workers)
+    timings["engine vs reference"] = time.perf_counter() - start
+
+    start = time.perf_counter()
+    progress("time histories (Figs 6-11)")
+    runs = {SIMPLIFIED: simulate(simplified_model(), options.end_time, options.accuracy)}
+    for mass in options.masses:
+        runs[(MODEL_I, mass)] = simulate(model_i(mass, 0.0), options.end_time, options.accuracy)
+        runs[(MODEL_II, mass)] = simulate(model_ii(mass, 0.0), options.end_time, options.accuracy)
+    data["runs"] = runs
+    timings["time histories"] = time.perf_counter() - start
+
+    start = time.perf_counter()
+    gaps = np.round(np.arange(0.0, options.gap_max + 1e-12, options.gap_step), 6)
+    progress(f"gap sweeps: {len(gaps)} gaps x {len(options.masses)} masses x 2 models")
+    sweep_scenes = [factory(m, float(g)) for factory in (model_i, model_ii) for m in options.masses for g in gaps]
+    points = run_sweep(sweep_scenes, options.end_time, options.accuracy, workers=options.workers)
+    sweeps: dict[tuple[str, float], list[tuple[float, float]]] = {}
+    failures = []
+    for point in points:
+        key = (point.scene.model_label, point.scene.absorber.mass)
+        if point.error:
+            failures.append({"scene": point.scene.name, "error": point.error})
+            continue
+        sweeps.setdefault(key, []).append((point.gap, point.max_barrel_displacement))
+    data["sweeps"], data["sweep_failures"] = sweeps, failures
+    timings["gap sweeps"] = time.perf_counter() - start
+
+    start = time.perf_counter()
+    progress("convention study")
+    cases = [c for c in CONVENTION_CASES if options.convention_labels is None or c[0] in options.convention_labels]
+    data["conventions"] = study_conventions(tuple(cases), workers=options.workers)
+    timings["convention study"] = time.perf_counter() - start
+
+    start = time.perf_counter()
+    progress("contact-law calibration on Section 2.2")
+    from .calibration import paper_section22_calibration, predict_table2
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        calibration = paper_section22_calibration(options.calibration_parameters, bounds=options.calibration_bounds
+                                                  or None)
+    data["calibration"] = calibration
+    data["calibration_table2"] = predict_table2(calibration)
+    timings["calibration"] = time.perf_counter() - start
+
+    x_max = {(SIMPLIFIED, m): runs[SIMPLIFIED].max_barrel_displacement for m in TABLE2_MASSES}
+    for mass in options.masses:
+        for label in (MODEL_I, MODEL_II):
+            x_max[(label, mass)] = runs[(label, mass)].max_barrel_displacement
+    data["x_max"] = x_max
+    if 1000.0 in options.masses:
+        evidence = ClaimEvidence(x_max=x_max, runs={MODEL_I: runs[(MODEL_I, 1000.0)],
+                                                    MODEL_II: runs[(MODEL_II, 1000.0)]}, sweeps=sweeps)
+        data["claims"] = evaluate_claims(evidence)
+    data["timings"] = timings
+    return data
+
+
+# ------------------------------------------------------------------------------------------- figures
+def _sweep_figure(data: dict, model: str, fig_number: int):
+    fig, axes = new_figure(1, 1, row_height=3.8)
+    ax = axes[0, 0]
+    colours = {100.0: "#2ca02c", 500.0: "#ff7f0e", 1000.0: "#9467bd"}
+    for mass in data["options"]["masses"]:
+        points = data["sweeps"].get((model, mass), [])
+        if points:
+            gaps, values = zip(*points)
+            ax.plot(np.array(gaps) * 1e3, np.array(values) * 1e3, color=colours.get(mass), label=f"m = {mass:g} kg")
+    reference = [(c["gap"], next(x for x in c["checks"] if x["name"] == "max_barrel_displacement")["reference"],
+                  c["absorber_mass"]) for c in data["comparisons"] if c["model"] == model]
+    if reference:
+        ax.plot([r[0] * 1e3 for r in reference], [r[1] * 1e3 for r in reference], "kx", ms=7,
+                label="independent reference")
+    simple = data["runs"][SIMPLIFIED].max_barrel_displacement
+    ax.axhline(simple * 1e3, color=MODEL_COLOURS[SIMPLIFIED], ls="--", lw=1, label=f"simplified {simple:.4f} m")
+    ax.set_xlabel("gap [mm]")
+    ax.set_ylabel("max barrel displacement [mm]")
+    ax.set_title(f"Fig. {fig_number}: max barrel displacement vs gap, {model}", fontsize=11)
+    ax.legend(fontsize=9)
+    return fig
+
+
+def _convention_figure(data: dict):
+    fig, axes = new_figure(1, 1, row_height=3.6)
+    ax = axes[0, 0]
+    for row in data["conventions"]:
+        ax.plot(np.array(TREND_GAPS) * 1e3, np.array(row.trend()) * 1e3, "o-", label=row.label)
+    ax.set_xlabel("gap [mm]")
+    ax.set_ylabel("max barrel displacement [mm]")
+    ax.set_title("Model (ii), m = 1000 kg: each reading of the paper vs gap (Fig. 5 claims a maximum at gap 0)",
+                 fontsize=10)
+    ax.legend(fontsize=8)
+    return fig
+
+
+def make_figures(data: dict) -> dict[str, bytes]:
+    """Every figure of the report as PNG bytes, keyed by file stem."""
+    runs = data["runs"]
+    figures = {"fig4_gap_sweep_model_i": _sweep_figure(data, MODEL_I, 4),
+               "fig5_gap_sweep_model_ii": _sweep_figure(data, MODEL_II, 5)}
+    for mass in data["options"]["masses"]:
+        pair = [runs[(MODEL_I, mass)], runs[(MODEL_II, mass)]]
+        tag = f"m{mass:g}"
+        figures[f"barrel_displacement_{tag}"] = plot_barrel_displacements(
+            [runs[SIMPLIFIED], *pair], title=f"Figs 6-8: barrel displacement, m = {mass:g} kg, gap 0")
+        figures[f"contact_force_{tag}"] = plot_contact_histories(
+            pair, "contact_force", title=f"Fig. 9: contact force between absorber and wall A, m = {mass:g} kg")
+        figures[f"absorber_velocity_{tag}"] = plot_contact_histories(
+            pair, "absorber_velocity", title=f"Fig. 10: absorber velocity, m = {mass:g} kg")
+        figures[f"first_impact_{tag}"] = plot_first_impact(pair, title=f"Fig. 11: first impact, m = {mass:g} kg")
+    figures["conventions_gap_trend"] = _convention_figure(data)
+    return {name: figure_png(fig) for name, fig in figures.items()}
+
+
+# --------------------------------------------------------------------------------------------- tables
+def table2_rows(data: dict) -> list[dict]:
+    """Table 2 from the gap-0 comparisons: engine, reference, paper, differences."""
+    published_table = table2()
+    by_case = {(c["model"], c["absorber_mass"] or 0.0): c for c in data["comparisons"] if not c["gap"]}
+    rows = []
+    for model in (SIMPLIFIED, MODEL_I, MODEL_II):
+        for mass in TABLE2_MASSES:
+            case = by_case.get((model, 0.0 if model == SIMPLIFIED else mass))
+            if case is None:
+                continue
+            check = next(x for x in case["checks"] if x["name"] == "max_barrel_displacement")
+            paper = published_table[(model, mass)].value
+            rows.append({"model": model, "absorber_mass": mass, "engine": check["engine"],
+                         "reference": check["reference"], "engine_vs_reference": check["relative_error"],
+                         "paper": paper, "difference": check["engine"] - paper,
+                         "relative_difference": (check["engine"] - paper) / paper})
+    return rows
+
+
+def table2_markdown(rows: list[dict]) -> str:
+    lines = ["| model | m [kg] | ours [m] | paper [m] | ours - paper [mm] | rel. diff. | engine vs reference |",
+             "|---|---:|---:|---:|---:|---:|---:|"]
+    for r in rows:
+        lines.append(f"| {r['model']} | {r['absorber_mass']:g} | {r['engine']:.4f} | {r['paper']:.4f} | "
+                     f"{r['difference'] * 1e3:+.2f} | {r['relative_difference'] * 100:+.2f} % | "
+                     f"{r['engine_vs_reference']:.1e} |")
+    return "\n".join(lines) + "\n"
+
+
+def section22_rows(data: dict) -> list[dict]:
+    """The Section 2.2 numbers (m = 1000 kg, gap 0): ours (engine) vs the paper."""
+    rows = []
+    if 1000.0 not in data["options"]["masses"]:
+        return rows
+    for model in (MODEL_I, MODEL_II):
+        run = data["runs"][(model, 1000.0)]
+        for quantity, ours in (("peak_contact_force", run.peak_contact_force),
+                               ("max_absorber_velocity", run.max_absorber_velocity),
+                               ("time_of_max_absorber_velocity", run.time_of_max_absorber_velocity)):
+            pv = published(quantity, model, 1000.0)
+            rows.append({"model": model, "quantity": quantity, "ours": ours, "paper": pv.value, "unit": pv.unit,
+                         "relative_difference": (ours - pv.value) / pv.value, "source": pv.source})
+    return rows
+
+
+def unreproduced(data: dict) -> list[dict]:
+    """Every published number we do not reproduce within :data:`REPRODUCED_WITHIN`, with the likely reason."""
+    conventions = data["conventions"]
+    calibration_rows = {(r["model"], r["absorber_mass"]): r for r in data["calibration_table2"]}
+    items = []
+
+    default_rms = next((row.rms_error() for row in conventions if not row.conventions.active), None)
+
+    def best_reading(errors_of: Callable) -> tuple[str, bool]:
+        """Text about the reading closest to the paper, and whether it reproduces the number."""
+        err, label, signed, rms = min((abs(errors_of(row)), row.label, errors_of(row), row.rms_error())
+                                      for row in conventions)
+        text = f"the closest reading of the paper is '{label}' at {signed * 100:+.1f} %"
+        if err <= REPRODUCED_WITHIN and label != "default (DESIGN.md)" and default_rms is not None:
+            text += (f", which reproduces this number but moves the others away (RMS over all published numbers "
+                     f"{rms * 100:.1f} % against {default_rms * 100:.1f} % by default): the paper may have used "
+                     "that reading for this case only")
+        return text, err <= REPRODUCED_WITHIN
+
+    for row in table2_rows(data):
+        if abs(row["relative_difference"]) <= REPRODUCED_WITHIN:
+            continue
+        key = (row["model"], row["absorber_mass"])
+        calibrated = calibration_rows.get(key)
+        text, explained = best_reading(lambda c: c.table2_errors()[key])
+        reason = [text]
+        if calibrated:
+            reason.append(f"the contact law calibrated on Section 2.2 gives {calibrated['relative_error'] * 100:+.1f} %")
+        if row["model"] == MODEL_II and row["paper"] == table2()[(SIMPLIFIED, row["absorber_mass"])].value:
+            reason.append("the published value equals the simplified model's exactly, as if the absorber were "
+                          "never hit, which gap 0 cannot give; the paper's own Fig. 6 sentence says model (ii) is "
+                          "lower -- most likely a transcription or set-up error in Table 2")
+        elif not explained:
+            reason.append("no reading and no contact law closes it, and Table 2 hardly depends on the contact law: "
+                          "the published value most likely comes from a set-up the paper does not describe")
+        items.append({"published": f"Table 2, {row['model']}, m = {row['absorber_mass']:g} kg", "paper": row["paper"],
+                      "ours": row["engine"], "unit": "m", "relative_difference": row["relative_difference"],
+                      "reason": "; ".join(reason)})
+    calibration = data["calibration"]
+    for row in section22_rows(data):
+        if abs(row["relative_difference"]) <= REPRODUCED_WITHIN:
+            continue
+        key = (row["model"], row["quantity"])
+        reason = [best_reading(lambda c: c.section22_errors()[key])[0]]
+        fitted = next((r for r in calibration.residuals if r.get("quantity") == row["quantity"]
+                       and row["model"] + ":" in r.get("description", "")), None)
+        law = calibration.parameters
+        law_text = ", ".join(f"{k} = {v:.3g}" for k, v in law.items())
+        if fitted is not None and fitted.get("relative_error") is not None:
+            reason.append(f"a contact law fitted to Section 2.2 ({law_text}) reproduces it to "
+                          f"{fitted['relative_error'] * 100:+.2f} %, so the published impact numbers most likely come "
+                          "from other contact parameters than Table 1")
+        items.append({"published": f"Section 2.2, {row['model']}, {row['quantity'].replace('_', ' ')}",
+                      "paper": row["paper"], "ours": row["ours"], "unit": row["unit"],
+                      "relative_difference": row["relative_difference"], "reason": "; ".join(reason)})
+    for verdict in data.get("claims", []):
+        if verdict.holds is False:
+            reason = verdict.evidence
+            if verdict.claim.key == "ii_max_at_gap_zero":
+                trend = {row.label: row.trend() for row in conventions}
+                literal = trend.get("literal_gap_sign")
+                if literal:
+                    reason += ("; only the literal gap sign of Eq. (6) (gap acting as an interference) makes the "
+                               f"displacement fall with the gap ({', '.join(f'{x:.4f}' for x in literal)} m at "
+                               f"{', '.join(f'{g * 1e3:g}' for g in TREND_GAPS)} mm), as Fig. 5 claims")
+            items.append({"published": f"claim ({verdict.claim.source}): {verdict.claim.text}", "paper": None,
+                          "ours": None, "unit": "", "relative_difference": None, "reason": reason})
+    return items
+
+
+# ------------------------------------------------------------------------------------------------ HTML
+_CSS = """
+body{font-family:system-ui,-apple-system,Segoe UI,Roboto,sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;
+color:#222;line-height:1.45}
+h1{font-size:1.6em}h2{border-bottom:2px solid #ddd;padding-bottom:.2em;margin-top:2em}
+table{border-collapse:collapse;margin:1em 0;font-size:.92em}th,td{border:1px solid #ccc;padding:.3em .6em;
+text-align:right}th{background:#f3f3f3}td.l,th.l{text-align:left}pre{background:#f7f7f7;padding:.8em;overflow-x:auto;
+font-size:.85em}figure{margin:1.2em 0}figure img{max-width:100%;border:1px solid #eee}figcaption{font-size:.9em;color:#555}
+.bad{color:#b00020;font-weight:600}.good{color:#1b7f2a;font-weight:600}.note{background:#fff8e1;padding:.6em 1em;
+border-left:4px solid #f0c000}
+"""
+
+
+def _e(text) -> str:
+    return html.escape(str(text))
+
+
+def _table(headers: list[str], rows: list[list], left: int = 1, table_id: str = "") -> str:
+    id_attr = f' id="{table_id}"' if table_id else ""
+    head = "".join(f'<th class="l">{_e(h)}</th>' if i < left else f"<th>{_e(h)}</th>" for i, h in enumerate(headers))
+    body = "".join("<tr>" + "".join(f'<td class="l">{c}</td>' if i < left else f"<td>{c}</td>"
+                                    for i, c in enumerate(row)) + "</tr>" for row in rows)
+    return f"<table{id_attr}><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+
+
+def _img(name: str, png: bytes, caption: str) -> str:
+    encoded = base64.b64encode(png).decode("ascii")
+    return (f'<figure id="fig-{name}"><img alt="{_e(caption)}" src="data:image/png;base64,{encoded}">'
+            f"<figcaption>{_e(caption)}</figcaption></figure>")
+
+
+def _fmt(value, digits: int = 4) -> str:
+    if value is None:
+        return "&ndash;"
+    if isinstance(value, float) and not math.isfinite(value):
+        return "&ndash;"
+    return f"{value:.{digits}g}"
+
+
+def _pct(value) -> str:
+    if value is None:
+        return "&ndash;"
+    cls = "bad" if abs(value) > REPRODUCED_WITHIN else "good"
+    return f'<span class="{cls}">{value * 100:+.2f} %</span>'
+
+
+_EQUATIONS = """Simplified model, Eq. (1):   M x_M'' + k x_M + c(x_M') x_M' = 0,   c = 6239 N s/m (x_M' > 0), 14050 N s/m (x_M' < 0)
+Model (i), Eqs. (4)-(5):     M x_M'' + k x_M + c x_M' + c_r (x_M' - x_m') + k_r (x_M - x_m) + F = 0
+                             m x_m'' - c_r (x_M' - x_m') - k_r (x_M - x_m) - F = 0
+Model (ii), Eqs. (7)-(8):    M x_M'' + k x_M + c x_M' + F = 0
+                             m x_m'' + k_r x_m + c_r x_m' - F = 0
+Contact, Eq. (6) (DESIGN):   p = (x_M - x_m) - gap,  F = k_c p^n_c (1 + lambda p') for p > 0, F >= 0 (never pulls)
+Initial state:               x_M = x_m = 0, x_m' = 0, x_M' = v0 = 6.86 kg * 564 m/s / 5600 kg = 0.6909 m/s
+(F is written here as the force pushing the absorber forward; the paper's F_ct = -F.)"""
+
+
+def _sketch(func) -> str:
+    doc = func.__doc__ or ""
+    lines = doc.split("::", 1)[-1].split("\n\n")[0] if "::" in doc else ""
+    return lines
+
+
+def render_html(data: dict, pngs: dict[str, bytes]) -> str:
+    """The report as one self-contained HTML page."""
+    parts = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>Recoil absorber replication report"
+             f"</title><style>{_CSS}</style></head><body>",
+             "<h1>Replication report: recoil mechanism with impact absorbers</h1>",
+             "<p>Engine: Exudyn (symbolic user functions, accuracy preset "
+             f"<code>{_e(data['options']['accuracy'])}</code>). Independent check: an event-driven scipy solution of "
+             "the same equations (<code>validation.reference</code>). Nothing is tuned to the published numbers; where "
+             "we differ, the difference is reported and studied.</p>"]
+    # models
+    parts.append("<h2 id='models'>1. Models and equations</h2>")
+    for title, func in (("Simplified model (Fig. 1)", _simp_doc), ("Model (i) (Fig. 2)", _model_i_doc),
+                        ("Model (ii) (Fig. 3)", _model_ii_doc)):
+        parts.append(f"<h3>{_e(title)}</h3><pre>{_e(_sketch(func))}</pre>")
+    parts.append(f"<pre>{_e(_EQUATIONS)}</pre>")
+    # parameters
+    parts.append("<h2 id='parameters'>2. Parameters</h2>")
+    rows = [[_e(p.quantity), _e(p.model), _fmt(p.value, 6), _e(p.unit), _e(p.source), _e(p.note)]
+            for p in published_values() if p.model == "all"]
+    parts.append(_table(["quantity", "model", "value", "unit", "source", "note"], rows, left=2, table_id="parameters"))
+    # table 2
+    t2 = table2_rows(data)
+    parts.append("<h2 id='table2'>3. Table 2: maximum barrel displacement (gap 0, 10 s)</h2>")
+    parts.append(_table(["model", "m [kg]", "ours [m]", "reference [m]", "paper [m]", "ours - paper [mm]",
+                         "relative", "engine vs reference"],
+                        [[_e(r["model"]), f"{r['absorber_mass']:g}", f"{r['engine']:.5f}", f"{r['reference']:.5f}",
+                          f"{r['paper']:.4f}", f"{r['difference'] * 1e3:+.2f}", _pct(r["relative_difference"]),
+                          f"{r['engine_vs_reference']:.1e}"] for r in t2], table_id="table2"))
+    # sweeps
+    parts.append("<h2 id='sweeps'>4. Gap sweeps (Figs 4 and 5)</h2>")
+    gap_step = data["options"]["gap_step"]
+    parts.append(f"<p>Gaps 0 to {data['options']['gap_max'] * 1e3:g} mm in {gap_step * 1e3:g} mm steps, engine; "
+                 "crosses mark the independent reference.</p>")
+    if data["sweep_failures"]:
+        parts.append(f"<p class='bad'>{len(data['sweep_failures'])} sweep points failed: "
+                     f"{_e(data['sweep_failures'][:3])}</p>")
+    parts.append(_img("fig4_gap_sweep_model_i", pngs["fig4_gap_sweep_model_i"], "Fig. 4 (ours): model (i)"))
+    parts.append(_img("fig5_gap_sweep_model_ii", pngs["fig5_gap_sweep_model_ii"], "Fig. 5 (ours): model (ii)"))
+    # time histories
+    parts.append("<h2 id='histories'>5. Time histories (Figs 6-8)</h2>")
+    for mass in data["options"]["masses"]:
+        name = f"barrel_displacement_m{mass:g}"
+        parts.append(_img(name, pngs[name], f"Barrel displacement, m = {mass:g} kg (paper: Figs 6-8)"))
+    parts.append("<h2 id='contact'>6. Contact force and absorber velocity (Figs 9-11)</h2>")
+    s22 = section22_rows(data)
+    parts.append(_table(["model", "quantity", "ours", "paper", "unit", "relative", "source"],
+                        [[_e(r["model"]), _e(r["quantity"].replace("_", " ")), _fmt(r["ours"], 5), _fmt(r["paper"], 5),
+                          _e(r["unit"]), _pct(r["relative_difference"]), _e(r["source"])] for r in s22],
+                        left=2, table_id="section22"))
+    for mass in data["options"]["masses"]:
+        for stem, caption in (("contact_force", "Contact force (Fig. 9), with the paper's detail windows"),
+                              ("absorber_velocity", "Absorber velocity (Fig. 10)"),
+                              ("first_impact", "First impact zoomed (Fig. 11)")):
+            name = f"{stem}_m{mass:g}"
+            parts.append(_img(name, pngs[name], f"{caption}, m = {mass:g} kg"))
+    # engine vs reference
+    parts.append("<h2 id='engine-vs-reference'>7. Engine vs independent reference, every case shown</h2>")
+    rows = []
+    for c in data["comparisons"]:
+        err = {x["name"]: x["relative_error"] for x in c["checks"]}
+        rows.append([_e(c["scene"]), _fmt(err.get("max_barrel_displacement"), 2),
+                     _fmt(err.get("peak_contact_force"), 2), _fmt(err.get("max_absorber_velocity"), 2),
+                     _fmt(err.get("barrel_position_history"), 2), _fmt(err.get("absorber_position_history"), 2),
+                     f"{c['engine_impacts']} / {c['reference_impacts']}",
+                     "<span class='good'>pass</span>" if c["passed"] else "<span class='bad'>FAIL</span>"])
+    parts.append("<p>Relative errors; tolerances 1e-4 (displacement), 1e-3 (force, velocity, histories); the "
+                 "impact counts must be equal.</p>")
+    parts.append(_table(["case", "x_max", "peak force", "v_max absorber", "x_M(t)", "x_m(t)",
+                         "impacts engine / ref.", "verdict"], rows, table_id="engine-vs-reference"))
+    # conventions
+    parts.append("<h2 id='conventions'>8. Convention study: readings of the paper</h2>")
+    parts.append("<p>Each reading alone (reference values; the engine runs the same scenes). Relative differences "
+                 "to the paper; RMS over the 6 Table 2 cells with an absorber and the 6 Section 2.2 numbers.</p>")
+    conv_rows = []
+    for row in data["conventions"]:
+        t2e = row.table2_errors()
+        s2e = row.section22_errors()
+        engine = row.engine_errors()
+        failures = sum(1 for v in engine.values() if isinstance(v, str))
+        worst = max((v for v in engine.values() if not isinstance(v, str)), default=None)
+        engine_text = (f"max {worst:.1e}" if worst is not None else "") + (
+            f"; <span class='bad'>{failures} cases fail</span> (sticking contact)" if failures else "")
+        conv_rows.append([_e(row.label)] + [_pct(t2e[(m, mass)]) for m in (MODEL_I, MODEL_II) for mass in TABLE2_MASSES]
+                         + [_pct(s2e[(MODEL_I, "peak_contact_force")]), _pct(s2e[(MODEL_I, "max_absorber_velocity")]),
+                            f"{row.rms_error() * 100:.1f} %",
+                            ", ".join(f"{x * 1e3:.1f}" for x in row.trend()), engine_text])
+    parts.append(_table(["reading", "(i) 100", "(i) 500", "(i) 1000", "(ii) 100", "(ii) 500", "(ii) 1000",
+                         "F (i)", "v (i)", "RMS", "(ii) x_max at 0/40/80 mm [mm]", "engine vs reference"],
+                        conv_rows, table_id="conventions"))
+    parts.append(_img("conventions_gap_trend", pngs["conventions_gap_trend"], "Model (ii) vs gap under each reading"))
+    # calibration
+    calibration = data["calibration"]
+    parts.append("<h2 id='calibration'>9. Contact-law calibration on Section 2.2</h2>")
+    parts.append(f"<pre>{_e(calibration.summary())}</pre>")
+    parts.append(_table(["model", "m [kg]", "predicted x_max [m]", "paper [m]", "relative"],
+                        [[_e(r["model"]), f"{r['absorber_mass']:g}", f"{r['max_barrel_displacement']:.4f}",
+                          _fmt(r["published"]), _pct(r["relative_error"])] for r in data["calibration_table2"]],
+                        table_id="calibration-table2"))
+    # claims
+    parts.append("<h2 id='claims'>10. The paper's qualitative claims</h2>")
+    parts.append(_table(["claim", "source", "holds?", "evidence"],
+                        [[_e(v.claim.text), _e(v.claim.source),
+                          "<span class='good'>yes</span>" if v.holds else
+                          ("&ndash;" if v.holds is None else "<span class='bad'>no</span>"), _e(v.evidence)]
+                         for v in data.get("claims", [])], left=4, table_id="claims"))
+    # unreproduced
+    parts.append("<h2 id='unreproduced'>11. Published numbers we cannot reproduce, and the most likely reason</h2>")
+    parts.append(f"<p>Counted as reproduced: within {REPRODUCED_WITHIN * 100:g} % of the published value.</p><ul "
+                 "id='unreproduced-list'>")
+    for item in data["unreproduced"]:
+        numbers = "" if item["paper"] is None else (
+            f" &mdash; paper {_fmt(item['paper'], 5)} {_e(item['unit'])}, ours {_fmt(item['ours'], 5)} "
+            f"{_e(item['unit'])} ({item['relative_difference'] * 100:+.1f} %)")
+        parts.append(f"<li><b>{_e(item['published'])}</b>{numbers}. {_e(item['reason'])}.</li>")
+    parts.append("</ul>")
+    timing_rows = [[_e(k), f"{v:.1f} s"] for k, v in data["timings"].items()]
+    parts.append("<h2 id='cost'>12. What this report cost</h2>" + _table(["stage", "wall time"], timing_rows))
+    parts.append("</body></html>")
+    return "\n".join(parts)
+
+
+def results_json(data: dict) -> dict:
+    """The machine-readable results (no NaN)."""
+    def clean(value):
+        if isinstance(value, float) and not math.isfinite(value):
+            return None
+        if isinstance(value, dict):
+            return {str(k): clean(v) for k, v in value.items()}
+        if isinstance(value, (list, tuple)):
+            return [clean(v) for v in value]
+        return value
+
+    return clean({
+        "options": data["options"],
+        "table2": table2_rows(data),
+        "section22": section22_rows(data),
+        "engine_vs_reference": data["comparisons"],
+        "gap_sweeps": [{"model": model, "absorber_mass": mass, "gap": [p[0] for p in points],
+                        "max_barrel_displacement": [p[1] for p in points]}
+                       for (model, mass), points in data["sweeps"].items()],
+        "sweep_failures": data["sweep_failures"],
+        "time_histories": {f"{key[0]}:{key[1]:g}" if isinstance(key, tuple) else key: run.metrics()
+                           for key, run in data["runs"].items()},
+        "conventions": [row.to_dict() for row in data["conventions"]],
+        "calibration": data["calibration"].to_dict(),
+        "calibration_table2": data["calibration_table2"],
+        "claims": [v.to_dict() for v in data.get("claims", [])],
+        "unreproduced": data["unreproduced"],
+        "timings": data["timings"],
+    })
+
+
+def write_report(out: str | Path, options: ReportOptions = ReportOptions(), progress: Progress = _silent) -> dict:
+    """Compute everything and write ``report.html``, ``results.json``, ``table2.md/json`` and PNGs to ``out``."""
+    out = prepare_output_dir(out)
+    start = time.perf_counter()
+    data = compute_report(options, progress)
+    progress("figures and report")
+    data["unreproduced"] = unreproduced(data)
+    pngs = make_figures(data)
+    from mbs_models.outputs import atomic_write_bytes
+    for name, png in pngs.items():
+        atomic_write_bytes(out / f"{name}.png", png)
+    rows = table2_rows(data)
+    atomic_write_text(out / "table2.md", "# Table 2: maximum barrel displacement, gap 0, 10 s\n\n"
+                      "Ours = Exudyn engine (standard); reference = independent scipy solution.\n\n" + table2_markdown(rows))
+    atomic_write_json(out / "table2.json", {"rows": rows})
+    data["timings"]["total"] = time.perf_counter() - start
+    atomic_write_json(out / "results.json", results_json(data))
+    atomic_write_text(out / "report.html", render_html(data, pngs))
+    return data
