@@ -87,6 +87,14 @@ def _comparison_scenes(options: ReportOptions) -> list[Scene]:
     return scenes
 
 
+def _counter(progress: Progress, label: str):
+    """A (done, total) progress callback that reports roughly every quarter."""
+    def report(done: int, total: int) -> None:
+        if done == total or done % max(1, total // 4) == 0:
+            progress(f"  {label}: {done}/{total}")
+    return report
+
+
 def compute_report(options: ReportOptions = ReportOptions(), progress: Progress = _silent) -> dict:
     """Run every computation of the report; return a dict of results (figures are made later)."""
     timings: dict[str, float] = {}
@@ -97,7 +105,8 @@ def compute_report(options: ReportOptions = ReportOptions(), progress: Progress 
     scenes = _comparison_scenes(options)
     if options.comparison_gaps == (0.0, 0.04, 0.08) and options.masses == TABLE2_MASSES:
         assert len(scenes) == 19
-    data["comparisons"] = parallel_map(_comparison_job, scenes, workers=options.workers)
+    data["comparisons"] = parallel_map(_comparison_job, scenes, workers=options.workers,
+                                       progress=_counter(progress, "cases"))
     timings["engine vs reference"] = time.perf_counter() - start
 
     start = time.perf_counter()
@@ -113,7 +122,8 @@ def compute_report(options: ReportOptions = ReportOptions(), progress: Progress 
     gaps = np.round(np.arange(0.0, options.gap_max + 1e-12, options.gap_step), 6)
     progress(f"gap sweeps: {len(gaps)} gaps x {len(options.masses)} masses x 2 models")
     sweep_scenes = [factory(m, float(g)) for factory in (model_i, model_ii) for m in options.masses for g in gaps]
-    points = run_sweep(sweep_scenes, options.end_time, options.accuracy, workers=options.workers)
+    points = run_sweep(sweep_scenes, options.end_time, options.accuracy, workers=options.workers,
+                       progress=_counter(progress, "runs"))
     sweeps: dict[tuple[str, float], list[tuple[float, float]]] = {}
     failures = []
     for point in points:
@@ -128,7 +138,8 @@ def compute_report(options: ReportOptions = ReportOptions(), progress: Progress 
     start = time.perf_counter()
     progress("convention study")
     cases = [c for c in CONVENTION_CASES if options.convention_labels is None or c[0] in options.convention_labels]
-    data["conventions"] = study_conventions(tuple(cases), workers=options.workers)
+    data["conventions"] = study_conventions(tuple(cases), workers=options.workers,
+                                            progress=_counter(progress, "runs"))
     timings["convention study"] = time.perf_counter() - start
 
     start = time.perf_counter()
