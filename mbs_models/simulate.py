@@ -30,6 +30,7 @@ from . import stability
 from .accuracy import SolverSettings, solver_settings_for
 from .assembly import Assembly, assemble
 from .errors import SceneError, SimulationError
+from .guard import StepBudget, step_budget
 from .postprocess import Samples, analyse
 from .result import Result
 from .scene import Scene
@@ -86,6 +87,10 @@ def _solve(assembly: Assembly, settings: SolverSettings, end_time: float) -> int
     mbs = assembly.mbs
     ss = exudyn_simulation_settings(settings, end_time)
     solver_type = getattr(exudyn.DynamicSolverType, settings.solver)
+    budget = None
+    if settings.adaptive and assembly.scene.contact is not None:
+        budget = StepBudget(step_budget(end_time))
+        mbs.SetPreStepUserFunction(budget)
     print_to_console = exudyn.config.printToConsole
     exudyn.config.printToConsole = False  # Exudyn's own failure banner; we raise with the reason instead
     try:
@@ -96,6 +101,8 @@ def _solve(assembly: Assembly, settings: SolverSettings, end_time: float) -> int
     finally:
         exudyn.config.printToConsole = print_to_console
     iteration = mbs.sys["dynamicSolver"].it
+    if budget is not None and budget.exhausted_at is not None:
+        raise SimulationError(budget.explanation(settings.solver, end_time))
     if not success:
         raise SimulationError(f"Exudyn {settings.solver} reported failure at t = {iteration.currentTime:.6g} s")
     if iteration.currentTime < end_time * (1.0 - 1e-9):

@@ -143,3 +143,12 @@ def test_fixed_step_solver_runs():
     result = simulate(simplified_model(), 2.0, SolverSettings(solver="RK44", step=1e-3))
     x_max, _ = damped_oscillator_maximum(5600.0, 27500.0, 6239.0, 6.86 * 564 / 5600)
     assert result.max_barrel_displacement == pytest.approx(x_max, rel=1e-8)
+
+
+def test_chattering_contact_fails_clearly_instead_of_running_for_hours():
+    """compression_only on model (ii) sticks at maximum compression: the force switches every step."""
+    from mbs_models import Conventions
+
+    scene = model_ii(1000.0, 0.0, Conventions(compression_only=True))
+    with pytest.raises(SimulationError, match="step budget"):
+        simulate(scene, 1.0)
