@@ -34,6 +34,13 @@ class HermiteTrajectory:
         i = np.clip(np.searchsorted(self.time, t, side="right") - 1, 0, len(self.time) - 2)
         return hermite(self.time[i], self.time[i + 1], self.y[i], self.y[i + 1], self.dy[i], self.dy[i + 1], t)
 
+    def on_intervals(self, fractions: np.ndarray) -> np.ndarray:
+        """Values at ``t_i + f h_i`` for every interval i and fraction f: shape (intervals, fractions)."""
+        t0, t1 = self.time[:-1, None], self.time[1:, None]
+        f = np.asarray(fractions, dtype=float)[None, :]
+        return hermite(t0, t1, self.y[:-1, None], self.y[1:, None], self.dy[:-1, None], self.dy[1:, None],
+                       t0 + f * (t1 - t0))
+
 
 def refine_maximum(time: np.ndarray, y: np.ndarray, dy: np.ndarray) -> tuple[float, float]:
     """Global maximum ``(value, time)`` of the Hermite interpolant of ``y`` (derivative ``dy``).
@@ -66,7 +73,7 @@ def refine_maximum(time: np.ndarray, y: np.ndarray, dy: np.ndarray) -> tuple[flo
 
 
 def refine_function_maximum(f: Callable[[np.ndarray], np.ndarray], time: np.ndarray, k: int,
-                            points: int = 257, levels: int = 3) -> tuple[float, float]:
+                            points: int = 65, levels: int = 4) -> tuple[float, float]:
     """Maximum ``(value, time)`` of a continuous function ``f(t)`` near sample ``k``.
 
     ``f`` takes an array of times.  It is searched over [t_{k-1}, t_{k+1}] on nested uniform grids
@@ -97,7 +104,7 @@ def refine_function_maximum(f: Callable[[np.ndarray], np.ndarray], time: np.ndar
 
 
 def refine_crossing(indicator: Callable[[np.ndarray], np.ndarray], t_false: float, t_true: float,
-                    points: int = 1025, levels: int = 3) -> float:
+                    points: int = 129, levels: int = 4) -> float:
     """Earliest time in (t_false, t_true] where the boolean ``indicator(times)`` turns True.
 
     Nested uniform grids: each level keeps the bracket around the first True point, so the

@@ -83,49 +83,46 @@ def find_impacts(scene: Scene, s: Samples, contact_force: np.ndarray, interp: _I
     return impacts
 
 
-def _cumulative_quadrature(t: np.ndarray, power) -> np.ndarray:
-    """Cumulative integral of ``power(times)`` over the sample intervals (3-point Gauss per interval)."""
-    h = np.diff(t)
-    nodes = t[:-1, None] + h[:, None] * _GL_NODES[None, :]
-    per_interval = (power(nodes) * _GL_WEIGHTS[None, :]).sum(axis=1) * h
+def _cumulative_quadrature(t: np.ndarray, power_at_nodes: np.ndarray) -> np.ndarray:
+    """Cumulative integral over the sample intervals from the power at each interval's Gauss nodes."""
+    per_interval = (power_at_nodes * _GL_WEIGHTS[None, :]).sum(axis=1) * np.diff(t)
     return np.concatenate([[0.0], np.cumsum(per_interval)])
 
 
 def energies(scene: Scene, s: Samples, interp: _Interpolant) -> tuple[dict[str, np.ndarray], np.ndarray, np.ndarray]:
     """Dissipated energy histories per element, stored (spring + contact) energy and kinetic energy, in J.
 
-    Dissipated powers: recoil damper ``c(v) v^2``; absorber damper ``c_r v_rel^2``; contact
+    Dissipated powers, integrated with 3-point Gauss quadrature on the Hermite-interpolated state
+    in every step: recoil damper ``c(v) v^2``; absorber damper ``c_r v_rel^2``; contact
     ``F p_dot - d/dt(k_c p^(n+1)/(n+1))`` (the part of the contact work not stored elastically).
     """
     t = s.time
     dissipated: dict[str, np.ndarray] = {}
     damper = scene.recoil_damper
+    barrel_v = interp.barrel_v.on_intervals(_GL_NODES)
     if damper.recoil > 0 or damper.counter_recoil > 0:
-        def recoil_power(x):
-            v = interp.barrel_v(x)
-            return forces.recoil_damper_force(v, damper, forces.NUMPY_OPS) * v
-        dissipated["recoil_damper"] = _cumulative_quadrature(t, recoil_power)
+        power = forces.recoil_damper_force(barrel_v, damper, forces.NUMPY_OPS) * barrel_v
+        dissipated["recoil_damper"] = _cumulative_quadrature(t, power)
     kinetic = 0.5 * scene.barrel.mass * s.barrel_velocity ** 2
     stored = 0.5 * scene.recoil_spring.stiffness * s.barrel_position ** 2
     absorber = scene.absorber
     if absorber is not None:
         mounted_on_barrel = absorber.mount == "barrel"
 
-        def absorber_relative(position_or_velocity_barrel, absorber_value):
-            return (position_or_velocity_barrel - absorber_value) if mounted_on_barrel else absorber_value
+        def absorber_relative(barrel_value, absorber_value):
+            return (barrel_value - absorber_value) if mounted_on_barrel else absorber_value
 
+        absorber_v = interp.absorber_v.on_intervals(_GL_NODES)
         if absorber.damping > 0:
-            def absorber_power(x):
-                v_rel = absorber_relative(interp.barrel_v(x), interp.absorber_v(x))
-                return absorber.damping * v_rel ** 2
-            dissipated["absorber_damper"] = _cumulative_quadrature(t, absorber_power)
-
-        def contact_power(x):
-            relative_velocity = interp.barrel_v(x) - interp.absorber_v(x)
-            return contact_force_at(scene, interp, x) * relative_velocity
+            power = absorber.damping * absorber_relative(barrel_v, absorber_v) ** 2
+            dissipated["absorber_damper"] = _cumulative_quadrature(t, power)
+        relative_velocity = barrel_v - absorber_v
+        relative_position_nodes = interp.barrel_x.on_intervals(_GL_NODES) - interp.absorber_x.on_intervals(_GL_NODES)
+        force = forces.hunt_crossley_force(relative_position_nodes, relative_velocity, scene.contact,
+                                           scene.conventions, forces.NUMPY_OPS)
         relative_position = s.barrel_position - s.absorber_position
         elastic = forces.contact_elastic_energy(relative_position, scene.contact, scene.conventions)
-        dissipated["contact"] = _cumulative_quadrature(t, contact_power) - (elastic - elastic[0])  # 0 at t = 0
+        dissipated["contact"] = _cumulative_quadrature(t, force * relative_velocity) - (elastic - elastic[0])
         kinetic = kinetic + 0.5 * absorber.mass * s.absorber_velocity ** 2
         spring_extension = absorber_relative(s.barrel_position, s.absorber_position)
         stored = stored + 0.5 * absorber.stiffness * spring_extension ** 2 + elastic
@@ -158,7 +155,11 @@ def analyse(scene: Scene, s: Samples, contact_force: np.ndarray | None, impact_t
         metrics.max_absorber_velocity, metrics.time_of_max_absorber_velocity = v_max, t_v
         metrics.impacts = find_impacts(scene, s, contact_force, interp, impact_threshold)
         k = int(np.argmax(contact_force))
-        if contact_force[k] > 0:
+        if metrics.impacts and max(i.peak_force for i in metrics.impacts) >= contact_force[k]:
+            strongest = max(metrics.impacts, key=lambda i: i.peak_force)  # already refined
+            metrics.peak_contact_force, metrics.time_of_peak_contact_force = (strongest.peak_force,
+                                                                              strongest.time_of_peak_force)
+        elif contact_force[k] > 0:
             peak, t_peak = refine_function_maximum(lambda x: contact_force_at(scene, interp, x), s.time, k)
             metrics.peak_contact_force, metrics.time_of_peak_contact_force = max(peak, float(contact_force[k])), t_peak
         else:
