@@ -24,7 +24,7 @@ __version__ = "0.1.0"
 
 # name -> module that defines it; loaded lazily (PEP 562) because these import Exudyn.
 _LAZY = {
-    "simulate": ".simulate",
+    "simulate": ".simulation",
     "Result": ".result",
     "Impact": ".result",
     "SolverSettings": ".accuracy",

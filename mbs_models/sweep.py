@@ -46,7 +46,7 @@ class SweepPoint:
 
 
 def _run_one(job: tuple[Scene, float, str | SolverSettings]) -> SweepPoint:
-    from .simulate import simulate
+    from .simulation import simulate
 
     scene, end_time, accuracy = job
     try:
@@ -80,7 +80,7 @@ def run_sweep(scenes: Sequence[Scene], end_time: float = 10.0, accuracy: str | S
     if not jobs:
         return []
     # validate the shared arguments once, in this process, so that bad input fails fast
-    from .simulate import _check_arguments
+    from .simulation import _check_arguments
     from .accuracy import solver_settings_for
     _check_arguments(scenes[0], end_time, 0.0)
     solver_settings_for(accuracy)
