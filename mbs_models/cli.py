@@ -43,7 +43,7 @@ def _resolve_scene(path: str):
 
 
 def _cmd_run(args) -> int:
-    from .simulate import simulate
+    from .simulation import simulate
 
     scene = _resolve_scene(args.scene)
     if args.plot:
