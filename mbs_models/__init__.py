@@ -7,7 +7,7 @@ Public API (one entry point per task)::
     print(result.max_barrel_displacement)
 
 Scene handling (:mod:`.scene`, :mod:`.scene_io`, :mod:`.models`) is imported eagerly and needs no
-Exudyn; the engine (:mod:`.simulate` and below) is imported on first use, so that the independent
+Exudyn; the engine (:mod:`.simulation` and below) is imported on first use, so that the independent
 ``validation`` package can read scenes without ever loading Exudyn.
 """
 
