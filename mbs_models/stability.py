@@ -390,14 +390,14 @@ def stepped_over_contacts(scene: Scene, time: np.ndarray, relative_position: np.
     h = np.diff(time)[candidates]
     a, b, c, d = _cubic_coefficients(h, penetration[candidates], penetration[candidates + 1],
                                      relative_velocity[candidates], relative_velocity[candidates + 1])
-    # maximum of the cubic on (0, 1): roots of 3a s^2 + 2b s + c
-    disc = (2 * b) ** 2 - 12 * a * c
+    # maximum of the cubic on (0, 1): roots of 3a s^2 + 2b s + c, in the cancellation-free form
+    # q = -(B + sign(B) sqrt(B^2 - 4AC)) / 2, s = q / A and C / q (a may be ~0: a parabola)
+    A, B, C = 3 * a, 2 * b, c
     best_s = np.full(len(candidates), np.nan)
     best_p = np.full(len(candidates), -np.inf)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        root = np.sqrt(np.where(disc >= 0, disc, np.nan))
-        for sign in (-1.0, 1.0):
-            s = np.where(np.abs(a) > 0, (-2 * b + sign * root) / (6 * a), -c / (2 * b))
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        q = -0.5 * (B + np.copysign(np.sqrt(np.where(B * B - 4 * A * C >= 0, B * B - 4 * A * C, np.nan)), B))
+        for s in (q / A, C / q):
             value = ((a * s + b) * s + c) * s + d
             better = (s > 0) & (s < 1) & np.isfinite(value) & (value > best_p)
             best_p = np.where(better, value, best_p)
