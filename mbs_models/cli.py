@@ -92,6 +92,31 @@ def _cmd_validate(args) -> int:
     return EXIT_OK if comparison.passed else EXIT_FAILED
 
 
+def _cmd_precision(args) -> int:
+    from validation.precision import preset_study, run_study
+
+    from .outputs import prepare_output_dir
+
+    scene = _resolve_scene(args.scene)
+    if not 0.0 < args.end_time <= 1e4:
+        raise SceneError("end_time", f"must be a number of seconds in (0, 10000], got {args.end_time!r}")
+    if args.repeats < 1:
+        raise SceneError("--repeats", f"must be a whole number >= 1, got {args.repeats}")
+    out = prepare_output_dir(args.out)
+    start = time.perf_counter()
+    study = run_study(scene, end_time=args.end_time, repeats=args.repeats, quick=args.quick, progress=_progress)
+    study.write(out)
+    print(study.summary_markdown().split("\n## All settings")[0])
+    if args.presets:
+        _progress("accuracy presets on the 19 paper cases")
+        presets = preset_study(end_time=args.end_time, repeats=args.repeats, progress=_progress)
+        presets.write(out)
+        print(presets.table_markdown())
+    print(f"wrote precision.md, precision.csv, precision.json, the work-precision figures"
+          f"{' and presets.md/json' if args.presets else ''} to {out} in {time.perf_counter() - start:.1f} s")
+    return EXIT_OK
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="recoil", description="Recoil mechanisms with impact absorbers (Exudyn).")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
@@ -123,6 +148,17 @@ def build_parser() -> argparse.ArgumentParser:
                        help="a reduced but complete report (coarse gap sweeps, two readings of the paper)")
     paper.add_argument("--workers", type=int, default=None, help="worker processes (default: all CPUs)")
     paper.set_defaults(handler=_cmd_paper)
+
+    precision = sub.add_parser("precision", help="work-precision study: error vs time of every solver and setting")
+    precision.add_argument("scene", nargs="?", default="model_ii",
+                           help="scene TOML file or shipped scene (default model_ii: m = 1000 kg, gap 0)")
+    precision.add_argument("--out", default="precision", help="output directory (default ./precision)")
+    precision.add_argument("--quick", action="store_true", help="a tiny grid (seconds instead of minutes)")
+    precision.add_argument("--end-time", type=float, default=10.0, help="simulated time in s (default 10)")
+    precision.add_argument("--repeats", type=int, default=3, help="timed runs per setting, median taken (default 3)")
+    precision.add_argument("--presets", action="store_true",
+                           help="also measure the accuracy presets on the 19 paper cases (presets.md/json)")
+    precision.set_defaults(handler=_cmd_precision)
     return parser
 
 

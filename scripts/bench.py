@@ -1,0 +1,377 @@
+#!/usr/bin/env python
+"""Benchmark of the ``standard`` path, in one process, printed as ratios measured in the same run.
+
+    python scripts/bench.py                      # model_ii (m = 1000 kg, gap 0), 10 s, everything
+    python scripts/bench.py --memory-runs 1000   # shorter memory test
+    python scripts/bench.py --scene model_i --skip-memory
+
+What it measures (not a timed test: the numbers depend on the machine; the ratios much less so):
+
+1. **Against scipy LSODA at equal accuracy**: the ``standard`` preset's errors (max barrel displacement,
+   peak contact force, max absorber velocity) against a tight truth (:func:`validation.precision.compute_truth`);
+   then the loosest LSODA tolerance (on the same equations, :func:`validation.precision.solve_plain`) whose
+   worst error is no larger; ratio of median wall times, complete runs and integration alone.
+2. **Against a compiled fixed-structure yardstick**: ``scripts/recoil_dopri5.c``, the same equations and
+   the same adaptive scheme (Dormand-Prince 5(4), Hairer's step control) at the preset's rtol, atol and
+   max step, compiled at run time with the system ``cc`` into a temporary directory and called through
+   ctypes: the physical limit of what an integrator of these equations costs.  Skipped (and said so)
+   without a C compiler.
+3. **Single-run cost breakdown**: import (in a fresh interpreter), assembly, solve, post-processing (and
+   its parts), as fractions of one complete run.
+4. **Memory**: RSS over N consecutive runs in this process (Exudyn keeps models alive unless reset;
+   ``simulate`` resets them): growth between the first 10 % and the end must be ~0.
+
+Absolute times are printed only in brackets beside the ratios, for context.
+"""
+
+from __future__ import annotations
+
+import argparse
+import ctypes
+import math
+import os
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+C_SOURCE = Path(__file__).resolve().parent / "recoil_dopri5.c"
+
+
+def ms(seconds: float) -> str:
+    return f"{seconds * 1e3:.3g} ms"
+
+
+# ------------------------------------------------------------------------------------------------ import
+
+def import_cost() -> dict[str, float]:
+    """Import times (s) in a fresh interpreter: exudyn alone, and everything a run needs."""
+    code = ("import time; t0 = time.perf_counter(); import numpy; t1 = time.perf_counter(); import exudyn; "
+            "t2 = time.perf_counter(); import mbs_models.simulation; t3 = time.perf_counter(); "
+            "print(t1 - t0, t2 - t1, t3 - t2)")
+    runs = []
+    for _ in range(3):
+        out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT,
+                             env={**os.environ, "PYTHONPATH": str(ROOT)}, check=True).stdout.split()
+        runs.append([float(x) for x in out])
+    numpy_t, exudyn_t, rest_t = (statistics.median(r[i] for r in runs) for i in range(3))
+    return {"numpy": numpy_t, "exudyn": exudyn_t, "mbs_models.simulation and what it imports": rest_t}
+
+
+# ------------------------------------------------------------------------------------------------ breakdown
+
+def breakdown_round(scene, end_time: float, stages: dict[str, list[float]]) -> None:
+    """One ``standard`` run called stage by stage as ``simulate`` does; appends each stage's time (s)."""
+    import importlib
+
+    from mbs_models import stability
+    from mbs_models.accuracy import solver_settings_for
+    from mbs_models.assembly import assemble
+    from mbs_models.postprocess import _Interpolant, analyse, energies, find_impacts
+
+    engine = importlib.import_module("mbs_models.simulation")
+    settings = solver_settings_for("standard")
+
+    def timed(name, function, *args):
+        start = time.perf_counter()
+        value = function(*args)
+        stages.setdefault(name, []).append(time.perf_counter() - start)
+        return value
+
+    timed("settings check (stability)", stability.check_settings, scene, settings, end_time)
+    assembly = timed("assembly (incl. symbolic user functions)", assemble, scene, settings.user_functions)
+    try:
+        accelerations = timed("initial accelerations", engine._initial_accelerations, assembly)
+        timed("solve (Exudyn SolveDynamic)", engine._solve, assembly, settings, end_time)
+        samples, force = timed("collect sensor data", engine._collect, assembly, end_time, settings, accelerations)
+    finally:
+        timed("release model (Reset)", assembly.close)
+    if force is not None:
+        timed("stepped-over-contact check", stability.stepped_over_contacts, scene, samples.time,
+              samples.barrel_position - samples.absorber_position,
+              samples.barrel_velocity - samples.absorber_velocity, force, 1000.0)
+    metrics = timed("metrics (analyse)", analyse, scene, samples, force, 1000.0)
+    if force is not None:
+        timed("  of which: impacts (find_impacts)", find_impacts, scene, samples, force, _Interpolant(samples),
+              1000.0)
+    timed("  of which: energies", energies, scene, samples, _Interpolant(samples))
+    error = metrics.kinetic_energy_history + metrics.stored_energy_history + sum(
+        metrics.dissipated_energy_history.values()) - stability.initial_energy(scene)
+    timed("energy-balance check", stability.check_energy_balance, scene, samples.time, error, "bench")
+
+
+# ------------------------------------------------------------------------------------------------ compiled yardstick
+
+class CompiledDopri5:
+    """``scripts/recoil_dopri5.c`` compiled with the system C compiler and loaded with ctypes."""
+
+    def __init__(self, directory: Path):
+        compiler = shutil.which(os.environ.get("CC", "cc")) or shutil.which("gcc") or shutil.which("clang")
+        if compiler is None:
+            raise RuntimeError("no C compiler (cc, gcc, clang) on PATH")
+        library = directory / "librecoil_dopri5.so"
+        subprocess.run([compiler, "-O2", "-shared", "-fPIC", "-o", str(library), str(C_SOURCE), "-lm"], check=True,
+                       capture_output=True)
+        self.compiler = compiler
+        self.lib = ctypes.CDLL(str(library))
+        d = ctypes.POINTER(ctypes.c_double)
+        self.lib.dopri5_recoil.argtypes = [d, ctypes.c_double, ctypes.c_double, ctypes.c_double, ctypes.c_double,
+                                           ctypes.c_double, ctypes.c_int, d, d, d, ctypes.POINTER(ctypes.c_long)]
+        self.lib.dopri5_recoil.restype = ctypes.c_int
+
+    def prepare(self, scene, end_time: float, rtol: float, atol: float, max_step: float):
+        """Allocate once; return a zero-argument callable that integrates and returns the sample count."""
+        from validation.equations import Parameters
+
+        P = Parameters.from_scene(scene)
+        params = np.array([P.M, P.k, P.c_recoil, P.c_counter, float(P.has_absorber), P.m, float(P.on_barrel), P.kr,
+                           P.cr, P.kc, P.n, P.lam, P.gap_offset], dtype=float)
+        capacity = int(50 * end_time / max_step) + 200_000
+        self.t = np.zeros(capacity)
+        self.y = np.zeros((capacity, 4))
+        self.f = np.zeros((capacity, 4))
+        self.stats = (ctypes.c_long * 2)()
+        ptr = lambda a: a.ctypes.data_as(ctypes.POINTER(ctypes.c_double))  # noqa: E731
+        args = (ptr(params), P.v0, float(end_time), rtol, atol, max_step, capacity, ptr(self.t), ptr(self.y),
+                ptr(self.f), self.stats)
+        self._keep = params
+
+        def run() -> int:
+            count = self.lib.dopri5_recoil(*args)
+            if count < 0:
+                raise RuntimeError(f"compiled DOPRI5 failed with code {count}")
+            return count
+        return run
+
+    def samples(self, count: int):
+        from mbs_models.postprocess import Samples
+
+        y, f = self.y[:count], self.f[:count]
+        return Samples(time=self.t[:count].copy(), barrel_position=y[:, 0].copy(), barrel_velocity=y[:, 1].copy(),
+                       barrel_acceleration=f[:, 1].copy(), absorber_position=y[:, 2].copy(),
+                       absorber_velocity=y[:, 3].copy(), absorber_acceleration=f[:, 3].copy())
+
+
+# ------------------------------------------------------------------------------------------------ memory
+
+def rss_bytes() -> int:
+    """Resident set size of this process in bytes (Linux /proc; else peak RSS from getrusage)."""
+    try:
+        with open("/proc/self/statm") as stream:
+            return int(stream.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+    except OSError:
+        import resource
+        return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+
+
+def memory_test(scene, runs: int, end_time: float, progress) -> list[tuple[int, int]]:
+    """RSS after each tenth of ``runs`` consecutive ``simulate`` calls: [(runs done, bytes)]."""
+    from mbs_models import simulate
+
+    marks = sorted({max(1, runs * k // 10) for k in range(1, 11)})
+    out = [(0, rss_bytes())]
+    for i in range(1, runs + 1):
+        simulate(scene, end_time, "standard")
+        if i in marks:
+            out.append((i, rss_bytes()))
+            progress(f"memory: {i} runs, RSS {out[-1][1] / 2**20:.1f} MiB")
+    return out
+
+
+# ------------------------------------------------------------------------------------------------ main
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--scene", default="model_ii", help="shipped scene or TOML file (default model_ii)")
+    parser.add_argument("--end-time", type=float, default=10.0, help="simulated time in s (default 10)")
+    parser.add_argument("--repeats", type=int, default=9,
+                        help="interleaved timing rounds, medians taken (default 9)")
+    parser.add_argument("--memory-runs", type=int, default=10_000, help="consecutive runs of the memory test")
+    parser.add_argument("--memory-end-time", type=float, default=0.05,
+                        help="simulated time of each memory-test run in s (default 0.05: the first impact)")
+    parser.add_argument("--skip-memory", action="store_true")
+    args = parser.parse_args(argv)
+
+    def say(message: str) -> None:
+        print(f"[bench] {message}", file=sys.stderr, flush=True)
+
+    warnings.simplefilter("ignore")
+    from mbs_models.cli import _resolve_scene
+    from mbs_models import simulate
+    from mbs_models.accuracy import ACCURACY_PRESETS
+    from validation.precision import (PRESET_METRICS, RunValues, _engine_values, compute_truth, relative_errors,
+                                      solve_plain)
+
+    scene = _resolve_scene(args.scene)
+    end_time = args.end_time
+    standard = ACCURACY_PRESETS["standard"]
+    print(f"bench: {scene.name}, {end_time:g} s, standard = {standard.label()} (atol {standard.absolute_tolerance:g}, "
+          f"max step {standard.max_step:g} s); medians of {args.repeats} interleaved rounds, all in this process")
+
+    say("truth (event-driven reference, rtol 1e-12)")
+    truth = compute_truth(scene, end_time, check_rtol=None)
+    metrics = [m for m in PRESET_METRICS if scene.has_absorber or m == "max_barrel_displacement"]
+
+    def worst(errors):
+        return max(errors[m] for m in metrics)
+
+    # ---------------------------------------------------------------- accuracy of each contender
+    say("standard preset")
+    simulate(scene, end_time, "standard")  # warm-up
+    result = simulate(scene, end_time, "standard")
+    standard_errors = relative_errors(_engine_values(result, truth), truth)
+    target = worst(standard_errors)
+
+    say("scipy LSODA: loosest tolerance at least as accurate as the standard preset")
+    lsoda_rtol = lsoda_errors = None
+    for rtol in [10.0 ** (-k / 2) for k in range(6, 27)]:  # 1e-3 ... 1e-13 in half decades
+        solution = solve_plain(scene, end_time, "LSODA", rtol)
+        values = RunValues(solution.max_barrel_displacement, solution.peak_contact_force,
+                           solution.max_absorber_velocity, solution.impacts,
+                           np.asarray(solution.sol(truth.grid)[0]))
+        errors = relative_errors(values, truth)
+        if worst(errors) <= target:
+            lsoda_rtol, lsoda_errors = rtol, errors
+            break
+
+    say("compiled DOPRI5 yardstick")
+    compiled_run = compiled_note = compiled = None
+    directory = tempfile.TemporaryDirectory(prefix="recoil-bench-")
+    try:
+        yardstick = CompiledDopri5(Path(directory.name))
+    except (RuntimeError, subprocess.CalledProcessError, OSError) as exc:
+        compiled_note = f"skipped: {getattr(exc, 'stderr', None) or exc}"
+    else:
+        compiled_run = yardstick.prepare(scene, end_time, standard.relative_tolerance, standard.absolute_tolerance,
+                                         standard.max_step)
+        count = compiled_run()
+        from mbs_models.peaks import HermiteTrajectory
+        from mbs_models.postprocess import analyse
+        from validation.equations import Parameters
+        from validation.precision import plain_contact_force
+
+        samples = yardstick.samples(count)
+        force = None
+        if scene.has_absorber:
+            state = np.vstack([samples.barrel_position, samples.barrel_velocity, samples.absorber_position,
+                               samples.absorber_velocity])
+            force = plain_contact_force(Parameters.from_scene(scene), state)
+        m = analyse(scene, samples, force, 1000.0)
+        values = RunValues(m.max_barrel_displacement, m.peak_contact_force, m.max_absorber_velocity,
+                           [(i.start, i.end, i.peak_force) for i in m.impacts],
+                           HermiteTrajectory(samples.time, samples.barrel_position, samples.barrel_velocity)(truth.grid))
+        compiled = (count - 1, relative_errors(values, truth), yardstick.compiler, int(yardstick.stats[1]))
+
+    # ---------------------------------------------------------------- timing, interleaved rounds
+    say(f"timing: {args.repeats} interleaved rounds (standard, LSODA, compiled, stage by stage)")
+    timings: dict[str, list[float]] = {}
+    stages: dict[str, list[float]] = {}
+
+    def add(name, seconds):
+        timings.setdefault(name, []).append(seconds)
+
+    def clock(name, function, *arguments):
+        """Call; record wall time as ``name`` and CPU time of this process as ``name cpu``."""
+        wall, cpu = time.perf_counter(), time.process_time()
+        value = function(*arguments)
+        add(name, time.perf_counter() - wall)
+        add(f"{name} cpu", time.process_time() - cpu)
+        return value
+
+    for _ in range(args.repeats):
+        run = clock("standard", simulate, scene, end_time, "standard")
+        add("standard solve", run.timings["solve"])
+        if lsoda_rtol is not None:
+            solution = clock("lsoda", solve_plain, scene, end_time, "LSODA", lsoda_rtol)
+            add("lsoda solve", solution.solve_time)
+        if compiled_run is not None:
+            for _ in range(5):
+                clock("compiled", compiled_run)
+            clock("compiled post", analyse, scene, samples, force, 1000.0)
+        breakdown_round(scene, end_time, stages)
+    directory.cleanup()
+    t = {name: statistics.median(values) for name, values in timings.items()}
+    stages = {name: statistics.median(values) for name, values in stages.items()}
+    t_standard, t_standard_solve = t["standard"], t["standard solve"]
+    lsoda = None if lsoda_rtol is None else (lsoda_rtol, lsoda_errors, t["lsoda"], t["lsoda solve"])
+    if compiled is not None:
+        steps, c_errors, compiler, rejected = compiled
+        compiled = (t["compiled"], steps, c_errors, t["compiled post"], compiler, rejected)
+
+    say("import cost (fresh interpreters)")
+    imports = import_cost()
+
+    # ---------------------------------------------------------------- memory
+    memory = None
+    if not args.skip_memory and args.memory_runs > 0:
+        say(f"memory: {args.memory_runs} consecutive runs of {args.memory_end_time:g} s")
+        start = time.perf_counter()
+        memory = memory_test(scene, args.memory_runs, args.memory_end_time, say)
+        memory_wall = time.perf_counter() - start
+
+    # ---------------------------------------------------------------- report
+    def err_text(errors):
+        return ", ".join(f"{m.replace('max_', '').replace('_', ' ')} {errors[m]:.1e}" for m in metrics)
+
+    load = t["standard"] / t["standard cpu"]
+    print()
+    print(f"standard preset: errors {err_text(standard_errors)}; {result.steps} steps; the solve is "
+          f"{100 * t_standard_solve / t_standard:.0f} % of a complete run [context: {ms(t_standard)}]")
+    print(f"machine load: wall / CPU time of the standard run {load:.2f} "
+          f"({'idle enough' if load < 1.15 else 'shared machine: trust the CPU-time ratios'})")
+    print("\n1. standard vs scipy LSODA at equal accuracy (same equations, no events, dense output)")
+    if lsoda is None:
+        print("   LSODA reached the standard preset's accuracy at no tolerance down to 1e-13: no ratio")
+    else:
+        rtol, lsoda_errors, t_lsoda, t_lsoda_solve = lsoda
+        print(f"   LSODA rtol {rtol:.3g} (atol rtol x 1e-2): errors {err_text(lsoda_errors)}")
+        print(f"   LSODA / standard, complete run (solve + metrics):   {t_lsoda / t_standard:6.2f}x "
+              f"(CPU time {t['lsoda cpu'] / t['standard cpu']:.2f}x) [{ms(t_lsoda)} vs {ms(t_standard)}]")
+        print(f"   LSODA / standard, integration alone:              {t_lsoda_solve / t_standard_solve:6.2f}x "
+              f"[{ms(t_lsoda_solve)} vs {ms(t_standard_solve)}]")
+    print("\n2. standard vs a compiled fixed-structure DOPRI5 of the same equations (the physical limit)")
+    if compiled is None:
+        print(f"   {compiled_note}")
+    else:
+        t_c, steps, c_errors, t_c_post, compiler, rejected = compiled
+        print(f"   compiled with {compiler} -O2: {steps} steps ({rejected} rejected; Exudyn: {result.steps}), "
+              f"errors {err_text(c_errors)}")
+        print(f"   standard solve / compiled integration:            {t_standard_solve / t_c:6.1f}x "
+              f"[{ms(t_standard_solve)} vs {ms(t_c)}]")
+        print(f"   standard complete run / compiled integration:     {t_standard / t_c:6.1f}x "
+              f"(CPU time {t['standard cpu'] / t['compiled cpu']:.1f}x)")
+        print(f"   standard complete run / (compiled + the same Python post-processing): "
+              f"{t_standard / (t_c + t_c_post):6.2f}x")
+    print("\n3. single-run cost breakdown (fractions of one complete standard run; import once per process)")
+    run_total = sum(v for k, v in stages.items() if not k.startswith("  "))
+    import_total = sum(imports.values())
+    print(f"   import (fresh interpreter), relative to one run: {import_total / run_total:6.1f}x "
+          f"[{ms(import_total)}: " + ", ".join(f"{k} {ms(v)}" for k, v in imports.items()) + "]")
+    for name, value in stages.items():
+        print(f"   {name:40s} {100 * value / run_total:5.1f} %  [{ms(value)}]")
+    print(f"   (stage sum / simulate() wall time: {run_total / t_standard:.2f})")
+    if memory is not None:
+        print(f"\n4. memory over {args.memory_runs} consecutive runs ({args.memory_end_time:g} s each, "
+              f"standard, symbolic user functions)")
+        base = memory[1][1] if len(memory) > 1 else memory[0][1]
+        for count, value in memory:
+            print(f"   after {count:6d} runs: RSS {value / 2**20:8.1f} MiB")
+        growth = memory[-1][1] - base
+        per_run = growth / max(1, memory[-1][0] - memory[1][0]) if len(memory) > 2 else 0.0
+        print(f"   growth from {memory[1][0]} to {memory[-1][0]} runs: {growth / 2**20:+.2f} MiB "
+              f"({per_run:+.0f} bytes per run; {'OK, no growth' if abs(growth) < 4 * 2**20 else 'GROWS'})"
+              f" [context: {args.memory_runs / memory_wall:.0f} runs/s]")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
