@@ -27,7 +27,7 @@ import exudyn
 import numpy as np
 
 from . import stability
-from .accuracy import SolverSettings, solver_settings_for
+from .accuracy import MIN_RELATIVE_TOLERANCE, SolverSettings, solver_settings_for
 from .assembly import Assembly, assemble
 from .errors import SceneError, SimulationError
 from .guard import StepBudget, step_budget
@@ -86,6 +86,29 @@ class _BudgetSpent(Exception):
     """Stops Exudyn from the pre-step function once the step budget is spent."""
 
 
+class _StepSizeStalled(SimulationError):
+    """The step guard stopped an adaptive solve (see :func:`_absolute_tolerance_settings`)."""
+
+
+def _absolute_tolerance_settings(settings: SolverSettings) -> SolverSettings | None:
+    """Equivalent adaptive settings that dodge Exudyn's error-scale bug; None if already used.
+
+    Exudyn 1.13's explicit solvers scale each coordinate's error by ``atol + max(y0, y1) * rtol``
+    (CSolverExplicit.cpp) -- a signed maximum, not ``max(|y0|, |y1|)``.  The scale is 0 where a
+    coordinate passes ``-atol/rtol``: the presets all have atol/rtol = 0.01, so a velocity of
+    -0.01 m/s.  Usually the solver hurries past; in a stiff persistent contact the step collapses to
+    its minimum and Exudyn re-tries it for ever (measured: three scenes found by the property tests
+    stall exactly at v = -0.01, -0.1 or -0.001 m/s for atol/rtol = 0.01, 0.1, 0.001).  The re-solve
+    uses (almost) pure absolute control, ``atol' = atol + rtol`` (the old tolerance at |y| = 1 m,
+    1 m/s) with the smallest ``rtol`` accepted, which moves the singular value to ``-atol'/rtol'``,
+    beyond -100 m/s.
+    """
+    if settings.relative_tolerance <= MIN_RELATIVE_TOLERANCE:
+        return None
+    return replace(settings, relative_tolerance=MIN_RELATIVE_TOLERANCE,
+                   absolute_tolerance=settings.absolute_tolerance + settings.relative_tolerance)
+
+
 def _raising_when_spent(budget: StepBudget):
     """The budget as a pre-step function that *raises* when spent: returning False is ignored while
     Exudyn's DOPRI5 is stuck re-trying one step at its minimum step size (measured: model (ii) with
@@ -114,14 +137,14 @@ def _solve(assembly: Assembly, settings: SolverSettings, end_time: float) -> int
         success = mbs.SolveDynamic(ss, solverType=solver_type)
     except Exception as exc:  # Exudyn wraps user-function exceptions in its own error types
         if budget is not None and budget.exhausted_at is not None:
-            raise SimulationError(budget.explanation(settings.solver, end_time)) from None
+            raise _StepSizeStalled(budget.explanation(settings.solver, end_time)) from None
         message = " ".join(str(exc).split())
         raise SimulationError(f"Exudyn {settings.solver} failed: {message[:500]}") from exc
     finally:
         exudyn.config.printToConsole = print_to_console
     iteration = mbs.sys["dynamicSolver"].it
     if budget is not None and budget.exhausted_at is not None:
-        raise SimulationError(budget.explanation(settings.solver, end_time))
+        raise _StepSizeStalled(budget.explanation(settings.solver, end_time))
     if not success:
         raise SimulationError(f"Exudyn {settings.solver} reported failure at t = {iteration.currentTime:.6g} s")
     if iteration.currentTime < end_time * (1.0 - 1e-9):
@@ -246,7 +269,8 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
     settings = solver_settings_for(accuracy, user_functions)
     stability.check_settings(scene, settings, float(end_time))  # unsafe steps: SceneError before solving
     t_start = _time.perf_counter()
-    for attempt in range(MAX_CONTACT_RETRIES + 1):
+    attempt = 0
+    while True:
         assembly = assemble(scene, settings.user_functions)
         t_assembled = _time.perf_counter()
         try:
@@ -254,10 +278,17 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
             steps = _solve(assembly, settings, float(end_time))
             t_solved = _time.perf_counter()
             samples, contact_force = _collect(assembly, float(end_time), settings, initial_accelerations)
+        except _StepSizeStalled as stalled:
+            retry = _absolute_tolerance_settings(settings) if settings.adaptive else None
+            if retry is None:
+                raise SimulationError(str(stalled)) from None
+            settings = retry  # once: the re-solve with absolute error control (see the function)
+            continue
         finally:
             assembly.close()
         retry = _settings_after_stepped_over_contacts(scene, samples, contact_force, settings,
                                                       float(impact_threshold), attempt)
+        attempt += 1
         if retry is None:
             break
         settings = retry
