@@ -45,30 +45,37 @@ class HermiteTrajectory:
 def refine_maximum(time: np.ndarray, y: np.ndarray, dy: np.ndarray) -> tuple[float, float]:
     """Global maximum ``(value, time)`` of the Hermite interpolant of ``y`` (derivative ``dy``).
 
-    The sample maximum is located first; on its two neighbouring intervals the interpolant's
-    derivative is a quadratic whose roots are solved exactly.
+    Every interval where the derivative turns from positive to non-positive holds a local maximum,
+    and so do the two intervals beside the sample maximum; on each, the interpolant's derivative is
+    a quadratic whose roots are solved exactly.  All local maxima are compared, not only the one
+    next to the largest sample: with many near-equal peaks (a rattling absorber) the largest sample
+    need not sit beside the largest peak.
     """
     time, y, dy = (np.asarray(a, dtype=float) for a in (time, y, dy))
     k = int(np.argmax(y))
     best_value, best_time = float(y[k]), float(time[k])
-    for i in (k - 1, k):
-        if i < 0 or i + 1 >= len(time):
-            continue
-        t0, t1 = time[i], time[i + 1]
-        h = t1 - t0
-        if h <= 0:
-            continue
-        # y(s) = a s^3 + b s^2 + c s + d on s in [0, 1]
-        y0, y1, d0, d1 = y[i], y[i + 1], dy[i] * h, dy[i + 1] * h
-        a = 2 * y0 + d0 - 2 * y1 + d1
-        b = -3 * y0 - 2 * d0 + 3 * y1 - d1
-        c = d0
-        for s in np.roots([3 * a, 2 * b, c]) if abs(a) + abs(b) > 0 else []:
-            if abs(s.imag) < 1e-12 and 0.0 <= s.real <= 1.0:
-                s = s.real
-                value = ((a * s + b) * s + c) * s + y0
-                if value > best_value:
-                    best_value, best_time = float(value), float(t0 + s * h)
+    h = np.diff(time)
+    near_sample_max = [i for i in (k - 1, k) if 0 <= i < len(h)]
+    i = np.union1d(np.flatnonzero((dy[:-1] > 0) & (dy[1:] <= 0)), near_sample_max).astype(int)
+    i = i[h[i] > 0]
+    if not len(i):
+        return best_value, best_time
+    # y(s) = a s^3 + b s^2 + c s + d on s in [0, 1]
+    y0, y1, d0, d1 = y[i], y[i + 1], dy[i] * h[i], dy[i + 1] * h[i]
+    a = 2 * y0 + d0 - 2 * y1 + d1
+    b = -3 * y0 - 2 * d0 + 3 * y1 - d1
+    c = d0
+    # roots of 3a s^2 + 2b s + c without cancellation: q = -(B + sign(B) sqrt(B^2 - 4AC)) / 2
+    A, B = 3 * a, 2 * b
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        disc = B * B - 4 * A * c
+        q = -0.5 * (B + np.copysign(np.sqrt(np.where(disc >= 0, disc, np.nan)), B))
+        for s in (q / A, c / q):
+            value = ((a * s + b) * s + c) * s + y0
+            value = np.where(np.isfinite(s) & (s >= 0.0) & (s <= 1.0) & np.isfinite(value), value, -np.inf)
+            j = int(np.argmax(value))
+            if value[j] > best_value:
+                best_value, best_time = float(value[j]), float(time[i[j]] + s[j] * h[i[j]])
     return best_value, best_time
 
 
