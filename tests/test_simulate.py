@@ -152,3 +152,20 @@ def test_chattering_contact_fails_clearly_instead_of_running_for_hours():
     scene = model_ii(1000.0, 0.0, Conventions(compression_only=True))
     with pytest.raises(SimulationError, match="step budget"):
         simulate(scene, 1.0)
+
+
+@pytest.mark.parametrize("factory", [simplified_model, model_ii])
+def test_solver_that_stops_early_with_success_is_a_simulation_error(monkeypatch, factory):
+    """Exudyn told to stop at half the end time returns success; that must not pass as a result."""
+    import mbs_models.simulation as simulation
+
+    original = simulation.exudyn_simulation_settings
+
+    def stopping_halfway(settings, end_time):
+        ss = original(settings, end_time)
+        ss.timeIntegration.endTime = 0.5 * end_time
+        return ss
+
+    monkeypatch.setattr(simulation, "exudyn_simulation_settings", stopping_halfway)
+    with pytest.raises(SimulationError, match="stopped early at t = 0.5 s"):
+        simulate(factory(), 1.0)

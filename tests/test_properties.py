@@ -1,0 +1,134 @@
+"""Property-based tests (hypothesis) over the scene parameter space.
+
+For any scene in the guaranteed ranges (see the README, "What is guaranteed"):
+
+* the engine returns finite results (no NaN, no SimulationError at the presets);
+* the contact force is never negative and is exactly 0 whenever Hunt-Crossley would pull;
+* energy is never created: kinetic + stored energy never exceeds the initial energy, dissipated
+  energies never decrease (both up to the preset's energy tolerance);
+* the engine agrees with the scipy reference within the tolerances of tests/test_hard_cases.py.
+
+The default run draws :data:`FAST_EXAMPLES` scenes at ``standard`` accuracy; ``-m slow`` draws more,
+at every preset.  Both are derandomized (CI sees the same scenes every time).  Minimal failing
+scenes found while developing are kept as ``@example`` regression cases.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, example, given, settings
+from hypothesis import strategies as st
+
+from mbs_models import Scene, model_i, model_ii, simulate
+from test_hard_cases import TOLERANCES, assert_physical, assert_within, compare, reference_for
+
+#: Simulated time per example, s: covers the first impacts and the barrel's maximum.
+END_TIME = 1.0
+FAST_EXAMPLES = 25
+SLOW_EXAMPLES = 40
+
+#: The guaranteed ranges (the README states the same).
+MASS_RANGE = (1.0, 20000.0)            # absorber mass, kg
+GAP_RANGE = (0.0, 0.3)                 # m; beyond ~0.22 m nothing is ever touched
+STIFFNESS_RANGE = (1e6, 1e12)          # k_c, N/m^n
+EXPONENT_RANGE = (1.0, 2.0)            # n_c
+LAMBDA_RANGE = (0.0, 100.0)            # s/m
+MUZZLE_VELOCITY_RANGE = (56.4, 5640.0)  # m/s: 0.1x to 10x the paper's 564 m/s
+
+
+def _log_uniform(low: float, high: float):
+    return st.floats(math.log10(low), math.log10(high)).map(lambda x: 10.0 ** x)
+
+
+@st.composite
+def scenes(draw) -> Scene:
+    """A model (i) or (ii) scene with every contact and absorber parameter drawn from its range."""
+    factory = draw(st.sampled_from([model_i, model_ii]))
+    mass = draw(_log_uniform(*MASS_RANGE))
+    gap = draw(st.one_of(st.just(0.0), st.floats(*GAP_RANGE)))
+    lam = draw(st.one_of(st.just(0.0), _log_uniform(0.01, LAMBDA_RANGE[1])))
+    changes = {
+        "contact.stiffness": draw(_log_uniform(*STIFFNESS_RANGE)),
+        "contact.exponent": draw(st.floats(*EXPONENT_RANGE)),
+        "contact.damping_factor": lam,
+        "firing.muzzle_velocity": draw(_log_uniform(*MUZZLE_VELOCITY_RANGE)),
+    }
+    if draw(st.booleans()):
+        changes["absorber.damping"] = draw(st.sampled_from([0.0, 367.5, 36750.0]))
+    if draw(st.integers(0, 3)) == 0:
+        changes["recoil_damper.recoil"] = changes["recoil_damper.counter_recoil"] = 0.0
+    return factory(mass, gap).with_changes(**changes)
+
+
+def check_scene(scene: Scene, accuracy: str, end_time: float = END_TIME) -> None:
+    result = simulate(scene, end_time, accuracy)  # a SimulationError fails the property
+    tolerance = TOLERANCES[accuracy]["energy"]
+    assert_physical(result, tolerance)
+    e0 = result.kinetic_energy_history[0] + result.stored_energy_history[0]
+    mechanical = result.kinetic_energy_history + result.stored_energy_history
+    assert np.max(mechanical) <= e0 * (1.0 + tolerance), "energy created"
+    ref = reference_for(scene, end_time, (), accuracy)
+    assert_within(compare(result, ref, TOLERANCES[accuracy]["time"]), accuracy, scene)
+
+
+FAST = settings(max_examples=FAST_EXAMPLES, deadline=None, derandomize=True, database=None,
+                suppress_health_check=[HealthCheck.too_slow])
+SLOW = settings(max_examples=SLOW_EXAMPLES, deadline=None, derandomize=True, database=None,
+                suppress_health_check=[HealthCheck.too_slow])
+
+
+# Minimal failing scenes found by the slow run, kept as regression cases:
+#: a 4.4 kg absorber bouncing to rest on the barrel: the reference separates its last bounce from the
+#: following persistent contact by 2 us, which no preset resolves (episodes closer than the time
+#: tolerance count as one)
+BOUNCING_TO_REST = model_ii(4.367332460522914, 0.21501808279806872).with_changes(**{
+    "firing.muzzle_velocity": 822.0226934082997, "contact.stiffness": 58095350520.579124,
+    "contact.exponent": 1.134897281128901, "contact.damping_factor": 0.1})
+#: the same pressed on with n = 1, lambda = 1: Exudyn's DOPRI5 stalled at t = 0.5707 s (standard and
+#: reference), where the velocities pass -atol/rtol = -0.01 m/s and Exudyn's error scale vanishes;
+#: simulate() now re-solves such stalls with absolute error control
+STALLING = BOUNCING_TO_REST.with_changes(**{"contact.exponent": 1.0, "contact.damping_factor": 1.0})
+#: a 1 kg absorber on a soft linear contact, nothing damped but the absorber: the same stall at the
+#: reference preset (t = 0.5762 s), and the last bounce's maximum velocity drew the reference's
+#: attention to v tolerances
+LIGHT_UNDAMPED = model_ii(1.0, 0.0).with_changes(**{
+    "recoil_damper.recoil": 0.0, "recoil_damper.counter_recoil": 0.0, "firing.muzzle_velocity": 100.0,
+    "contact.stiffness": 1e8, "contact.exponent": 1.0, "contact.damping_factor": 0.0, "absorber.damping": 0.0})
+
+
+@FAST
+@given(scene=scenes())
+@example(scene=BOUNCING_TO_REST)
+@example(scene=LIGHT_UNDAMPED)
+def test_random_scenes_standard(scene):
+    check_scene(scene, "standard")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("accuracy", list(TOLERANCES))
+def test_random_scenes_every_preset(accuracy):
+    @SLOW
+    @given(scene=scenes())
+    def run(scene):
+        check_scene(scene, accuracy)
+
+    run()
+
+
+#: The regression scenes at every preset.  Their references are the expensive part (a stiff persistent
+#: contact makes scipy's explicit DOP853 take 3-60 s per simulated second), so the two scenes whose
+#: rtol 1e-12 reference takes minutes are checked at draft and standard only; the stall itself is
+#: covered at the reference preset by tests/test_stability.py::test_stalled_step_size_is_re_solved.
+REGRESSIONS = {"bouncing-to-rest": (BOUNCING_TO_REST, ("draft", "standard")),
+               "stalling": (STALLING, ("draft", "standard")),
+               "light-undamped": (LIGHT_UNDAMPED, ("draft", "standard", "reference"))}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name, accuracy", [(name, accuracy) for name, (_, presets) in REGRESSIONS.items()
+                                            for accuracy in presets])
+def test_regression_scenes_every_preset(name, accuracy):
+    check_scene(REGRESSIONS[name][0], accuracy)
