@@ -29,3 +29,23 @@ def test_readme_table2_matches_the_engine(row):
     x_max = simulate(scene, 10.0).max_barrel_displacement
     assert f"{x_max:.4f}" == ours
     assert float(difference_mm.replace("−", "-")) == pytest.approx((x_max - float(paper)) * 1e3, abs=0.006)
+
+
+_GUARANTEE_ROW = re.compile(r"^\| `(draft|standard|reference)` \| (\S+) \(worst [^)]*\) \| (\S+) \(worst [^)]*\) \| "
+                            r"(\S+) \(worst [^)]*\) \| (\S+) \(worst [^)]*\) \| (\d+) (ms|µs) \(worst [^)]*\) \|$")
+
+
+def test_readme_guarantees_are_the_tested_tolerances():
+    """The "What is guaranteed" table states exactly the bounds tests/test_hard_cases.py enforces."""
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from test_hard_cases import TOLERANCES
+
+    rows = [m.groups() for line in README.read_text().splitlines() if (m := _GUARANTEE_ROW.match(line))]
+    assert [r[0] for r in rows] == list(TOLERANCES)
+    for preset, energy, metric, force, impact_peak, time_value, unit in rows:
+        tol = TOLERANCES[preset]
+        assert (float(energy), float(metric), float(force), float(impact_peak)) == (
+            tol["energy"], tol["metric"], tol["force"], tol["impact_peak"]), preset
+        assert float(time_value) * (1e-3 if unit == "ms" else 1e-6) == pytest.approx(tol["time"], rel=1e-12), preset
