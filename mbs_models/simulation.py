@@ -347,13 +347,15 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
             break
         settings = retry
     stopped = tracker is not None and tracker.done
+    final = FINAL_METRICS
     if stopped:  # which other metrics are final too: all of them are checked at the last state
         last = -1
         tracker.observe_last(float(samples.time[last]), float(samples.barrel_position[last]),
                              float(samples.barrel_velocity[last]),
                              *((float(samples.absorber_position[last]), float(samples.absorber_velocity[last]))
                                if samples.absorber_position is not None else ()))
-    metrics = analyse(scene, samples, contact_force, float(impact_threshold))
+        final = tuple(n for n in FINAL_METRICS if n in tracker.final)
+    metrics = analyse(scene, samples, contact_force, float(impact_threshold), final)  # unproven ones: not computed
     for name in ("max_barrel_displacement", "max_absorber_velocity", "peak_contact_force"):
         value = getattr(metrics, name)
         if value is not None and not math.isfinite(value):
@@ -369,10 +371,10 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
         result.wall_time = _time.perf_counter() - t_start
         return result
     if stopped:
-        stop_reason, final = STOP_METRICS_FINAL, tuple(n for n in FINAL_METRICS if n in tracker.final)
+        stop_reason = STOP_METRICS_FINAL
         _drop_unproven(metrics, final)
     else:
-        stop_reason, final = (STOP_NO_BOUND if requested and not early_stop else STOP_END_TIME), FINAL_METRICS
+        stop_reason = STOP_NO_BOUND if requested and not early_stop else STOP_END_TIME
     t_end = _time.perf_counter()
     return Result(
         scene=scene, settings=settings, end_time=simulated_end if stopped else float(end_time), time=samples.time,

@@ -123,7 +123,7 @@ def compute_report(options: ReportOptions = ReportOptions(), progress: Progress 
     progress(f"gap sweeps: {len(gaps)} gaps x {len(options.masses)} masses x 2 models")
     sweep_scenes = [factory(m, float(g)) for factory in (model_i, model_ii) for m in options.masses for g in gaps]
     points = run_sweep(sweep_scenes, options.end_time, options.accuracy, workers=options.workers,
-                       progress=_counter(progress, "runs"))
+                       progress=_counter(progress, "runs"), stop_when_final=("max_barrel_displacement",))
     sweeps: dict[tuple[str, float], list[tuple[float, float]]] = {}
     failures = []
     for point in points:
