@@ -147,16 +147,16 @@ def test_bad_metric_names_raise_scene_error_naming_the_argument(bad):
 
 
 # --------------------------------------------------------------------------- the bounds themselves
+# (compression_only at gap 40 mm sticks, which the engine cannot integrate: its bounds are checked on the
+# reference, tests/test_validation_finality.py)
 BOUND_SCENES = ["simplified", "i-m100-gap0mm", "ii-m1000-gap0mm", "ii-m100-gap120mm", "i-m500-gap40mm",
-                "ii-soft-contact", "ii-compression_only", "ii-literal_gap_sign", "i-literal_gap_sign"]
+                "ii-soft-contact", "ii-literal_gap_sign", "i-literal_gap_sign", "i-v0_includes_absorber"]
 
 
 @pytest.mark.parametrize("key", BOUND_SCENES)
 def test_the_bounds_bound_everything_later_in_a_simulated_run(key):
     """Along a full run: max over [t_i, 10 s] of each quantity <= its bound from E(t_i) (no slack)."""
     scene, result = SCENES[key], _full(key)
-    if isinstance(result, Exception):
-        pytest.skip("the engine cannot integrate this scene (sticking contact)")
     b = fm.EnergyBounds(scene)
     absorber = scene.absorber is not None
     x_M, v_M = result.barrel_position, result.barrel_velocity
