@@ -32,6 +32,8 @@ _LAZY = {
     "solver_settings_for": ".accuracy",
     "assemble": ".assembly",
     "Assembly": ".assembly",
+    "FINAL_METRICS": ".final_metrics",   # names accepted by simulate(..., stop_when_final=...)
+    "EnergyBounds": ".final_metrics",
 }
 
 __all__ = [

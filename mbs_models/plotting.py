@@ -55,8 +55,9 @@ def plot_result(result: Result, *, title: str | None = None) -> Figure:
     ax.plot(result.time, result.barrel_position * 1e3, color=MODEL_COLOURS["simplified"], label="barrel $x_M$")
     if has_absorber:
         ax.plot(result.time, result.absorber_position * 1e3, color=MODEL_COLOURS["model (ii)"], label="absorber $x_m$")
-    ax.plot([result.time_of_max_barrel_displacement], [result.max_barrel_displacement * 1e3], "ko", ms=4,
-            label=f"max {result.max_barrel_displacement * 1e3:.2f} mm")
+    if result.max_barrel_displacement is not None:  # None: an early-stopped run that did not prove it final
+        ax.plot([result.time_of_max_barrel_displacement], [result.max_barrel_displacement * 1e3], "ko", ms=4,
+                label=f"max {result.max_barrel_displacement * 1e3:.2f} mm")
     ax.set_ylabel("position [mm]")
     ax.legend(fontsize=8, loc="upper right")
     ax = axes[1, 0]

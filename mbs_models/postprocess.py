@@ -133,8 +133,8 @@ def energies(scene: Scene, s: Samples, interp: _Interpolant) -> tuple[dict[str, 
 class Metrics:
     """All scalar results of one solve (see :class:`~mbs_models.result.Result`)."""
 
-    max_barrel_displacement: float
-    time_of_max_barrel_displacement: float
+    max_barrel_displacement: float | None
+    time_of_max_barrel_displacement: float | None
     peak_contact_force: float | None = None
     time_of_peak_contact_force: float | None = None
     max_absorber_velocity: float | None = None
@@ -145,25 +145,46 @@ class Metrics:
     kinetic_energy_history: np.ndarray | None = None
 
 
-def analyse(scene: Scene, s: Samples, contact_force: np.ndarray | None, impact_threshold: float) -> Metrics:
-    """Compute every metric of a solve from its samples."""
+#: Every metric :func:`analyse` can compute.
+ALL_METRICS = ("max_barrel_displacement", "peak_contact_force", "max_absorber_velocity", "impacts")
+
+
+def analyse(scene: Scene, s: Samples, contact_force: np.ndarray | None, impact_threshold: float,
+            wanted: tuple[str, ...] = ALL_METRICS) -> Metrics:
+    """Compute the metrics of a solve from its samples: those in ``wanted``, and always the energies.
+
+    Metrics left out are None (the contact force peak and the impacts share one search: asking for
+    either computes both).
+    """
     interp = _Interpolant(s)
-    x_max, t_x = refine_maximum(s.time, s.barrel_position, s.barrel_velocity)
-    metrics = Metrics(max_barrel_displacement=x_max, time_of_max_barrel_displacement=t_x, impacts=[])
-    if scene.absorber is not None:
-        v_max, t_v = refine_maximum(s.time, s.absorber_velocity, s.absorber_acceleration)
-        metrics.max_absorber_velocity, metrics.time_of_max_absorber_velocity = v_max, t_v
-        metrics.impacts = find_impacts(scene, s, contact_force, interp, impact_threshold)
-        k = int(np.argmax(contact_force))
-        if metrics.impacts and max(i.peak_force for i in metrics.impacts) >= contact_force[k]:
-            strongest = max(metrics.impacts, key=lambda i: i.peak_force)  # already refined
-            metrics.peak_contact_force, metrics.time_of_peak_contact_force = (strongest.peak_force,
-                                                                              strongest.time_of_peak_force)
-        elif contact_force[k] > 0:
-            peak, t_peak = refine_function_maximum(lambda x: contact_force_at(scene, interp, x), s.time, k)
-            metrics.peak_contact_force, metrics.time_of_peak_contact_force = max(peak, float(contact_force[k])), t_peak
-        else:
-            metrics.peak_contact_force, metrics.time_of_peak_contact_force = 0.0, None  # no contact at all
+    metrics = Metrics(max_barrel_displacement=None, time_of_max_barrel_displacement=None)
+    if "max_barrel_displacement" in wanted:
+        metrics.max_barrel_displacement, metrics.time_of_max_barrel_displacement = refine_maximum(
+            s.time, s.barrel_position, s.barrel_velocity)
+    if scene.absorber is None:
+        metrics.impacts = []
+    else:
+        if "max_absorber_velocity" in wanted:
+            v_max, t_v = refine_maximum(s.time, s.absorber_velocity, s.absorber_acceleration)
+            metrics.max_absorber_velocity, metrics.time_of_max_absorber_velocity = v_max, t_v
+        if "impacts" in wanted or "peak_contact_force" in wanted:
+            _contact_metrics(scene, s, contact_force, interp, impact_threshold, metrics)
     (metrics.dissipated_energy_history, metrics.stored_energy_history,
      metrics.kinetic_energy_history) = energies(scene, s, interp)
     return metrics
+
+
+def _contact_metrics(scene: Scene, s: Samples, contact_force: np.ndarray, interp: _Interpolant,
+                     impact_threshold: float, metrics: Metrics) -> None:
+    """The impacts and the refined peak contact force, into ``metrics``."""
+    metrics.impacts = find_impacts(scene, s, contact_force, interp, impact_threshold)
+    k = int(np.argmax(contact_force))
+    if metrics.impacts and max(i.peak_force for i in metrics.impacts) >= contact_force[k]:
+        strongest = max(metrics.impacts, key=lambda i: i.peak_force)  # already refined
+        metrics.peak_contact_force, metrics.time_of_peak_contact_force = (strongest.peak_force,
+                                                                          strongest.time_of_peak_force)
+    elif contact_force[k] > 0:
+        peak, t_peak = refine_function_maximum(lambda x: contact_force_at(scene, interp, x), s.time, k)
+        metrics.peak_contact_force, metrics.time_of_peak_contact_force = max(peak, float(contact_force[k])), t_peak
+    else:
+        metrics.peak_contact_force, metrics.time_of_peak_contact_force = 0.0, None  # no contact at all

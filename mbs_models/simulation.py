@@ -7,7 +7,10 @@ Contract
   :class:`~mbs_models.accuracy.SolverSettings`.
 * The return value is a complete :class:`~mbs_models.result.Result`, or a
   :class:`~mbs_models.errors.SimulationError` is raised: a solver that fails, stops before
-  ``end_time``, or produces NaN/inf never yields a result.  Bad arguments raise
+  ``end_time``, or produces NaN/inf never yields a result.  The one exception is asked for:
+  ``stop_when_final`` stops the solve once energy bounds prove the named metrics final
+  (:mod:`mbs_models.final_metrics`); the result says so (``stop_reason``, ``requested_end_time``)
+  and holds None for every metric not proven final.  Bad arguments raise
   :class:`~mbs_models.errors.SceneError` naming the argument.
 * Numerical safety (:mod:`mbs_models.stability`): a fixed step that is unstable for the scene or
   would step over an impact is refused before solving (SceneError, key ``step``, with the safe
@@ -22,6 +25,7 @@ from __future__ import annotations
 import math
 import time as _time
 from dataclasses import replace
+from typing import Sequence
 
 import exudyn
 import numpy as np
@@ -30,6 +34,9 @@ from . import stability
 from .accuracy import MIN_RELATIVE_TOLERANCE, SolverSettings, solver_settings_for
 from .assembly import Assembly, assemble
 from .errors import SceneError, SimulationError
+from .final_metrics import (ENERGY_SLACK, FINAL_METRICS, STOP_END_TIME, STOP_ENERGY_CHECK, STOP_METRICS_FINAL, STOP_NO_BOUND,
+                            FinalityTracker, check_metric_names, dissipative,
+                            largest_energy_rise)
 from .guard import StepBudget, step_budget
 from .postprocess import Samples, analyse
 from .result import Result
@@ -39,6 +46,9 @@ from .scene import Scene
 MAX_END_TIME = 1.0e4
 #: Re-solves (with max_step / 4 each) when an adaptive solver stepped over a whole contact.
 MAX_CONTACT_RETRIES = 3
+#: The finality tracker (stop_when_final) is shown the state at every this-many-th step: reading the
+#: state costs ~5 us per call in a solve, the bound check ~3-10 us, a step ~5 us.
+OBSERVE_EVERY = 4
 #: Most output samples kept for fixed-step solvers (output is thinned beyond this).
 MAX_FIXED_STEP_SAMPLES = 1_000_000
 
@@ -109,28 +119,56 @@ def _absolute_tolerance_settings(settings: SolverSettings) -> SolverSettings | N
                    absolute_tolerance=settings.absolute_tolerance + settings.relative_tolerance)
 
 
-def _raising_when_spent(budget: StepBudget):
-    """The budget as a pre-step function that *raises* when spent: returning False is ignored while
-    Exudyn's DOPRI5 is stuck re-trying one step at its minimum step size (measured: model (ii) with
-    m = 1 kg, k_c = 1e12 at rtol <= 1e-10 never passes t = 0.4924 s)."""
+def _pre_step_function(assembly: Assembly, budget: StepBudget | None, tracker: FinalityTracker | None):
+    """Exudyn pre-step function: the step budget (raises when spent) and the finality tracker.
+
+    The budget *raises* when spent: returning False is ignored while Exudyn's DOPRI5 is stuck
+    re-trying one step at its minimum step size (measured: model (ii) with m = 1 kg, k_c = 1e12 at
+    rtol <= 1e-10 never passes t = 0.4924 s).  The tracker is shown the state at the start of every
+    :data:`OBSERVE_EVERY`-th step (Exudyn's current coordinates; ``t`` is the end of the step about to
+    be taken); the function returns False once every requested metric is final: Exudyn then
+    completes that step and stops, so the output ends one step after the state that proved finality.
+    """
+    data = assembly.mbs.systemData
+    barrel = data.GetNodeLTGODE2(assembly.nodes["barrel"])[0]
+    absorber = data.GetNodeLTGODE2(assembly.nodes["absorber"])[0] if "absorber" in assembly.nodes else None
+    calls = [0]
 
     def pre_step(mbs, t):
-        if not budget(mbs, t):
+        if budget is not None and not budget(mbs, t):
             raise _BudgetSpent(f"step budget spent at t = {t:.6g} s")
+        if tracker is not None:
+            calls[0] += 1
+            if calls[0] % OBSERVE_EVERY:
+                return True
+            q = data.GetODE2Coordinates(copy=False).tolist()
+            v = data.GetODE2Coordinates_t(copy=False).tolist()
+            if absorber is None:
+                done = tracker.observe(t, q[barrel], v[barrel])
+            else:
+                done = tracker.observe(t, q[barrel], v[barrel], q[absorber], v[absorber])
+            if done:
+                return False
         return True
 
     return pre_step
 
 
-def _solve(assembly: Assembly, settings: SolverSettings, end_time: float) -> int:
-    """Run Exudyn; return the number of steps.  Raise SimulationError on any failure."""
+def _solve(assembly: Assembly, settings: SolverSettings, end_time: float,
+           tracker: FinalityTracker | None = None) -> tuple[int, float]:
+    """Run Exudyn; return the number of steps and the simulated end time (s).
+
+    The solve ends at ``end_time``, or earlier only when ``tracker`` proved every requested metric
+    final.  Raise SimulationError on any failure (including any other early stop).
+    """
     mbs = assembly.mbs
     ss = exudyn_simulation_settings(settings, end_time)
     solver_type = getattr(exudyn.DynamicSolverType, settings.solver)
     budget = None
     if settings.adaptive and assembly.scene.contact is not None:
         budget = StepBudget(step_budget(end_time))
-        mbs.SetPreStepUserFunction(_raising_when_spent(budget))
+    if budget is not None or tracker is not None:
+        mbs.SetPreStepUserFunction(_pre_step_function(assembly, budget, tracker))
     print_to_console = exudyn.config.printToConsole
     exudyn.config.printToConsole = False  # Exudyn's own failure banner; we raise with the reason instead
     try:
@@ -147,10 +185,11 @@ def _solve(assembly: Assembly, settings: SolverSettings, end_time: float) -> int
         raise _StepSizeStalled(budget.explanation(settings.solver, end_time))
     if not success:
         raise SimulationError(f"Exudyn {settings.solver} reported failure at t = {iteration.currentTime:.6g} s")
-    if iteration.currentTime < end_time * (1.0 - 1e-9):
+    stopped_final = tracker is not None and tracker.done
+    if iteration.currentTime < end_time * (1.0 - 1e-9) and not stopped_final:
         raise SimulationError(f"Exudyn {settings.solver} stopped early at t = {iteration.currentTime:.6g} s "
                               f"of {end_time:g} s")
-    return int(iteration.currentStepIndex)
+    return int(iteration.currentStepIndex), float(iteration.currentTime)
 
 
 def _initial_accelerations(assembly: Assembly) -> dict[str, float]:
@@ -242,7 +281,8 @@ def _settings_after_stepped_over_contacts(scene: Scene, samples: Samples, contac
 
 
 def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSettings = "standard", *,
-             user_functions: str | None = None, impact_threshold: float = 1000.0) -> Result:
+             user_functions: str | None = None, impact_threshold: float = 1000.0,
+             stop_when_final: Sequence[str] = ()) -> Result:
     """Simulate ``scene`` from t = 0 to ``end_time`` (s) with Exudyn and return a :class:`Result`.
 
     Parameters
@@ -252,6 +292,17 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
     accuracy: ``"draft"``, ``"standard"`` (default) or ``"reference"``, or a :class:`SolverSettings`.
     user_functions: override the settings' backend: ``"symbolic"`` (C++) or ``"python"``.
     impact_threshold: a contact episode counts as an impact when its peak force exceeds this (N).
+    stop_when_final: metric names among :data:`~mbs_models.final_metrics.FINAL_METRICS`
+        (``"max_barrel_displacement"``, ``"peak_contact_force"``, ``"max_absorber_velocity"``,
+        ``"impacts"``).  The solve stops as soon as energy bounds prove that none of them can change
+        before ``end_time`` (:mod:`mbs_models.final_metrics`); the result then covers
+        ``[0, result.end_time]`` with ``result.requested_end_time`` = ``end_time``,
+        ``result.stop_reason == "metrics_final"``, and every metric *not* proven final at the stop
+        (with its time) is None (``impacts`` too), never a value of the shorter window.  Scenes that
+        inject energy (``literal_lambda_sign``) have no bound and run to ``end_time``
+        (``stop_reason == "end_time_no_energy_bound"``).  An early stop is trusted only if the run's
+        energy-balance error stayed below the bounds' slack; otherwise the scene is re-solved to
+        ``end_time`` (``stop_reason == "end_time_energy_check"``).  Empty (default): run to ``end_time``.
 
     Raises
     ------
@@ -266,18 +317,21 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
         balance is off by more than 1 % of the initial energy.
     """
     _check_arguments(scene, end_time, impact_threshold)
+    requested = check_metric_names(stop_when_final)
     settings = solver_settings_for(accuracy, user_functions)
     stability.check_settings(scene, settings, float(end_time))  # unsafe steps: SceneError before solving
+    early_stop = bool(requested) and dissipative(scene)
     t_start = _time.perf_counter()
     attempt = 0
     while True:
+        tracker = FinalityTracker(scene, requested, impact_threshold) if early_stop else None
         assembly = assemble(scene, settings.user_functions)
         t_assembled = _time.perf_counter()
         try:
             initial_accelerations = _initial_accelerations(assembly)
-            steps = _solve(assembly, settings, float(end_time))
+            steps, simulated_end = _solve(assembly, settings, float(end_time), tracker)
             t_solved = _time.perf_counter()
-            samples, contact_force = _collect(assembly, float(end_time), settings, initial_accelerations)
+            samples, contact_force = _collect(assembly, simulated_end, settings, initial_accelerations)
         except _StepSizeStalled as stalled:
             retry = _absolute_tolerance_settings(settings) if settings.adaptive else None
             if retry is None:
@@ -292,7 +346,16 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
         if retry is None:
             break
         settings = retry
-    metrics = analyse(scene, samples, contact_force, float(impact_threshold))
+    stopped = tracker is not None and tracker.done
+    final = FINAL_METRICS
+    if stopped:  # which other metrics are final too: all of them are checked at the last state
+        last = -1
+        tracker.observe_last(float(samples.time[last]), float(samples.barrel_position[last]),
+                             float(samples.barrel_velocity[last]),
+                             *((float(samples.absorber_position[last]), float(samples.absorber_velocity[last]))
+                               if samples.absorber_position is not None else ()))
+        final = tuple(n for n in FINAL_METRICS if n in tracker.final)
+    metrics = analyse(scene, samples, contact_force, float(impact_threshold), final)  # unproven ones: not computed
     for name in ("max_barrel_displacement", "max_absorber_velocity", "peak_contact_force"):
         value = getattr(metrics, name)
         if value is not None and not math.isfinite(value):
@@ -301,9 +364,20 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
     energy_error = (metrics.kinetic_energy_history + metrics.stored_energy_history + sum(dissipated_history.values())
                     - stability.initial_energy(scene))
     stability.check_energy_balance(scene, samples.time, energy_error, f"Exudyn {settings.label()}")
+    if stopped and largest_energy_rise(metrics.kinetic_energy_history + metrics.stored_energy_history) > ENERGY_SLACK:
+        # the solution's energy rose by more than the bounds' slack: do not trust the early stop
+        result = simulate(scene, end_time, settings, impact_threshold=impact_threshold)
+        result.stop_reason = STOP_ENERGY_CHECK
+        result.wall_time = _time.perf_counter() - t_start
+        return result
+    if stopped:
+        stop_reason = STOP_METRICS_FINAL
+        _drop_unproven(metrics, final)
+    else:
+        stop_reason = STOP_NO_BOUND if requested and not early_stop else STOP_END_TIME
     t_end = _time.perf_counter()
     return Result(
-        scene=scene, settings=settings, end_time=float(end_time), time=samples.time,
+        scene=scene, settings=settings, end_time=simulated_end if stopped else float(end_time), time=samples.time,
         barrel_position=samples.barrel_position, barrel_velocity=samples.barrel_velocity,
         barrel_acceleration=samples.barrel_acceleration, absorber_position=samples.absorber_position,
         absorber_velocity=samples.absorber_velocity, absorber_acceleration=samples.absorber_acceleration,
@@ -319,4 +393,17 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
         kinetic_energy_history=metrics.kinetic_energy_history,
         wall_time=t_end - t_start, steps=steps,
         timings={"assembly": t_assembled - t_start, "solve": t_solved - t_assembled, "postprocess": t_end - t_solved},
+        requested_end_time=float(end_time), stop_reason=stop_reason, final_metrics=final,
     )
+
+
+def _drop_unproven(metrics, final: tuple[str, ...]) -> None:
+    """Set every metric not proven final (and its time) to None: a shorter window's value is no result."""
+    if "max_barrel_displacement" not in final:
+        metrics.max_barrel_displacement = metrics.time_of_max_barrel_displacement = None
+    if "peak_contact_force" not in final:
+        metrics.peak_contact_force = metrics.time_of_peak_contact_force = None
+    if "max_absorber_velocity" not in final:
+        metrics.max_absorber_velocity = metrics.time_of_max_absorber_velocity = None
+    if "impacts" not in final:
+        metrics.impacts = None

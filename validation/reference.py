@@ -29,7 +29,8 @@ from mbs_models.scene import Scene
 
 from . import equations as eq
 from .equations import OFF, ON, STICK, Mode, Parameters
-from .result import ReferenceImpact, ReferenceResult, ReferenceSegment
+from .finality import METRICS, Finality, check_names
+from .result import STOP_END_TIME, STOP_METRICS_FINAL, STOP_NO_BOUND, ReferenceImpact, ReferenceResult, ReferenceSegment
 
 __all__ = ["METHODS", "ReferenceSolveError", "solve_reference", "ReferenceResult", "ReferenceImpact",
            "ReferenceSegment"]
@@ -203,7 +204,7 @@ def _check_args(scene, end_time, method, rtol, atol, impact_threshold, max_step,
 
 def solve_reference(scene: Scene, end_time: float = 10.0, *, method: str = "DOP853", rtol: float = 1e-10,
                     atol: float = 1e-12, impact_threshold: float = 1000.0, max_step: float = 0.01,
-                    max_segments: int = 20000) -> ReferenceResult:
+                    max_segments: int = 20000, stop_when_final=()) -> ReferenceResult:
     """Integrate Eqs. (1)-(8) for ``scene`` over ``[0, end_time]`` s with event-driven ``solve_ivp``.
 
     Parameters
@@ -216,13 +217,24 @@ def solve_reference(scene: Scene, end_time: float = 10.0, *, method: str = "DOP8
     impact_threshold: contact episodes with a peak force above this (N) are reported as impacts.
     max_step: largest solver step in s (keeps grazing contacts from being stepped over).
     max_segments: cap on the number of smooth segments; more raises :class:`ReferenceSolveError`.
+    stop_when_final: metric names among :data:`validation.finality.METRICS`; the integration stops
+        once energy bounds (:mod:`validation.finality`) prove that none of them can change before
+        ``end_time``: checked at every segment end, and inside a segment by a terminal event (which
+        leaves the solver's steps before it unchanged, so the window is the full run's prefix).  The
+        result then covers ``[0, result.end_time]``, ``result.stop_reason == "metrics_final"``, and
+        metrics not proven final are None.  Scenes that inject energy (``literal_lambda_sign``) run
+        to ``end_time`` (``stop_reason == "end_time_no_energy_bound"``).
 
     Raises
     ------
     ReferenceSolveError: solver failure, non-finite state, or chattering (too many segments).
+    ValueError: a bad argument (names it).
     """
     _check_args(scene, end_time, method, rtol, atol, impact_threshold, max_step, max_segments)
+    requested = check_names(stop_when_final)
     P = Parameters.from_scene(scene)
+    finality = Finality(P, requested, impact_threshold) if requested else None
+    early = finality is not None and finality.enabled
     y = np.array([0.0, P.v0, 0.0, 0.0, 0.0, 0.0, 0.0])
     energy0 = sum(eq.energy_components(P, y).values())
     e_scale = max(float(energy0), 1.0)
@@ -236,11 +248,13 @@ def solve_reference(scene: Scene, end_time: float = 10.0, *, method: str = "DOP8
                                       f"(chattering / Zeno behaviour?) in scene {scene.name!r}")
         flags = _Flags(P, y, hints)
         funcs, names = flags.events(P, t, y)
+        contact_off = flags.mode.contact == OFF
+        stop = [finality.stop_event(contact_off)] if early else []
         # rejected trial steps of an explicit method on a stiff contact may overflow; accepted states
         # are checked for finiteness below, so the floating-point warnings are noise, not results
         with np.errstate(over="ignore", invalid="ignore"):
             sol = solve_ivp(partial(eq.rhs, P, flags.mode), (t, end_time), y, method=method, rtol=rtol,
-                            atol=atol_vec, dense_output=True, events=funcs or None, max_step=max_step)
+                            atol=atol_vec, dense_output=True, events=(funcs + stop) or None, max_step=max_step)
         nfev += sol.nfev
         if sol.status < 0:
             raise ReferenceSolveError(f"solve_ivp ({method}) failed at t = {t:.9g} s in mode {flags.mode}: "
@@ -258,6 +272,13 @@ def solve_reference(scene: Scene, end_time: float = 10.0, *, method: str = "DOP8
             hints = {missed[1]: dict(zip(names, funcs))[missed[1]].direction > 0}
         if t_new > t:
             segments.append(ReferenceSegment(t, t_new, flags.mode, sol.sol))
+        if early and t_new > t:
+            finality.observe_segment(flags.mode, sol.sol, t, t_new)
+            finality.check(y, contact_off)
+            if finality.done:
+                finality.check(y, contact_off, METRICS)  # which others are final here too
+                t = t_new
+                break
         if t_new - t <= 1e-14 * max(1.0, t):
             stalls += 1
             if stalls > _MAX_STALLS:
@@ -266,6 +287,12 @@ def solve_reference(scene: Scene, end_time: float = 10.0, *, method: str = "DOP8
         else:
             stalls = 0
         t = t_new
-    return ReferenceResult(scene=scene, end_time=float(end_time), segments=segments, parameters=P,
-                           method=method, rtol=rtol, atol=atol, impact_threshold=impact_threshold,
-                           nfev=nfev, wall_time=time.perf_counter() - start)
+    stopped = early and finality.done and t < end_time
+    if stopped:
+        reason, final = STOP_METRICS_FINAL, tuple(m for m in METRICS if m in finality.final)
+    else:
+        reason, final = (STOP_NO_BOUND if requested and not early else STOP_END_TIME), METRICS
+    return ReferenceResult(scene=scene, end_time=float(t) if stopped else float(end_time), segments=segments,
+                           parameters=P, method=method, rtol=rtol, atol=atol, impact_threshold=impact_threshold,
+                           nfev=nfev, wall_time=time.perf_counter() - start, requested_end_time=float(end_time),
+                           stop_reason=reason, final_metrics=final)

@@ -15,6 +15,7 @@ import base64
 import html
 import json
 import math
+import os
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -59,6 +60,7 @@ class ReportOptions:
     accuracy: str = "standard"
     end_time: float = 10.0
     workers: int | None = None
+    studies: bool = True                     # False: no convention study, no calibration (--reproduce-only)
 
     @classmethod
     def reduced(cls, **changes) -> "ReportOptions":
@@ -69,15 +71,25 @@ class ReportOptions:
         base.update(changes)
         return cls(**base)
 
+    @classmethod
+    def reproduction(cls, **changes) -> "ReportOptions":
+        """The paper's results only: Table 2 (engine and reference at gap 0), the full gap sweeps, every
+        figure of the paper and the report, without the convention study, the calibration and the
+        engine-vs-reference cases at gaps 40 and 80 mm (``recoil paper --reproduce-only``)."""
+        base = dict(comparison_gaps=(0.0,), studies=False)
+        base.update(changes)
+        return cls(**base)
+
 
 # --------------------------------------------------------------------------------------------- compute
-def _comparison_job(scene: Scene) -> dict:
+def _comparison_job(scene: Scene) -> tuple[dict, object]:
+    """The comparison of one case as a dict, and the engine's 10 s run of a gap-0 case (reused for Figs 6-11)."""
     comparison = compare(scene, 10.0, "standard")
     data = comparison.to_dict()
     data["model"] = scene.model_label
     data["absorber_mass"] = scene.absorber.mass if scene.absorber else None
     data["gap"] = scene.contact.gap if scene.contact else None
-    return data
+    return data, (comparison.engine if not data["gap"] else None)
 
 
 def _comparison_scenes(options: ReportOptions) -> list[Scene]:
@@ -99,22 +111,35 @@ def compute_report(options: ReportOptions = ReportOptions(), progress: Progress 
     """Run every computation of the report; return a dict of results (figures are made later)."""
     timings: dict[str, float] = {}
     data: dict = {"options": {k: v for k, v in options.__dict__.items()}}
+    from mbs_models.sweep import default_workers
+    data["machine"] = {"cpus": os.cpu_count(), "workers": options.workers or default_workers(),
+                       "load_average_at_start": round(os.getloadavg()[0], 2) if hasattr(os, "getloadavg") else None}
 
     start = time.perf_counter()
     progress("engine vs reference on the paper cases")
     scenes = _comparison_scenes(options)
     if options.comparison_gaps == (0.0, 0.04, 0.08) and options.masses == TABLE2_MASSES:
         assert len(scenes) == 19
-    data["comparisons"] = parallel_map(_comparison_job, scenes, workers=options.workers,
-                                       progress=_counter(progress, "cases"))
+    outputs = parallel_map(_comparison_job, scenes, workers=options.workers, progress=_counter(progress, "cases"))
+    data["comparisons"] = [case for case, _ in outputs]
     timings["engine vs reference"] = time.perf_counter() - start
 
     start = time.perf_counter()
     progress("time histories (Figs 6-11)")
-    runs = {SIMPLIFIED: simulate(simplified_model(), options.end_time, options.accuracy)}
+    # the comparisons ran the gap-0 cases for 10 s at "standard" already: reuse those runs when they match
+    compared = {(run.scene.model_label, run.scene.absorber.mass if run.scene.absorber else None): run
+                for _, run in outputs if run is not None}
+    reuse = options.end_time == 10.0 and options.accuracy == "standard"
+
+    def run_of(label: str, mass: float | None, scene_factory) -> object:
+        if reuse and (label, mass) in compared:
+            return compared[(label, mass)]
+        return simulate(scene_factory(), options.end_time, options.accuracy)
+
+    runs = {SIMPLIFIED: run_of(SIMPLIFIED, None, simplified_model)}
     for mass in options.masses:
-        runs[(MODEL_I, mass)] = simulate(model_i(mass, 0.0), options.end_time, options.accuracy)
-        runs[(MODEL_II, mass)] = simulate(model_ii(mass, 0.0), options.end_time, options.accuracy)
+        runs[(MODEL_I, mass)] = run_of(MODEL_I, mass, lambda: model_i(mass, 0.0))
+        runs[(MODEL_II, mass)] = run_of(MODEL_II, mass, lambda: model_ii(mass, 0.0))
     data["runs"] = runs
     timings["time histories"] = time.perf_counter() - start
 
@@ -123,7 +148,7 @@ def compute_report(options: ReportOptions = ReportOptions(), progress: Progress 
     progress(f"gap sweeps: {len(gaps)} gaps x {len(options.masses)} masses x 2 models")
     sweep_scenes = [factory(m, float(g)) for factory in (model_i, model_ii) for m in options.masses for g in gaps]
     points = run_sweep(sweep_scenes, options.end_time, options.accuracy, workers=options.workers,
-                       progress=_counter(progress, "runs"))
+                       progress=_counter(progress, "runs"), stop_when_final=("max_barrel_displacement",))
     sweeps: dict[tuple[str, float], list[tuple[float, float]]] = {}
     failures = []
     for point in points:
@@ -135,30 +160,32 @@ def compute_report(options: ReportOptions = ReportOptions(), progress: Progress 
     data["sweeps"], data["sweep_failures"] = sweeps, failures
     timings["gap sweeps"] = time.perf_counter() - start
 
-    start = time.perf_counter()
-    progress("convention study")
-    cases = [c for c in CONVENTION_CASES if options.convention_labels is None or c[0] in options.convention_labels]
-    data["conventions"] = study_conventions(tuple(cases), workers=options.workers,
-                                            progress=_counter(progress, "runs"))
-    timings["convention study"] = time.perf_counter() - start
+    data["conventions"], data["calibration"], data["calibration_table2"] = [], None, []
+    if options.studies:
+        start = time.perf_counter()
+        progress("convention study")
+        cases = [c for c in CONVENTION_CASES if options.convention_labels is None or c[0] in options.convention_labels]
+        data["conventions"] = study_conventions(tuple(cases), workers=options.workers,
+                                                progress=_counter(progress, "runs"))
+        timings["convention study"] = time.perf_counter() - start
 
-    start = time.perf_counter()
-    progress("contact-law calibration on Section 2.2")
-    from .calibration import paper_section22_calibration, predict_table2
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        calibration = paper_section22_calibration(options.calibration_parameters, bounds=options.calibration_bounds
-                                                  or None)
-    data["calibration"] = calibration
-    data["calibration_table2"] = predict_table2(calibration)
-    timings["calibration"] = time.perf_counter() - start
+        start = time.perf_counter()
+        progress("contact-law calibration on Section 2.2")
+        from .calibration import paper_section22_calibration, predict_table2
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            calibration = paper_section22_calibration(options.calibration_parameters,
+                                                      bounds=options.calibration_bounds or None)
+        data["calibration"] = calibration
+        data["calibration_table2"] = predict_table2(calibration)
+        timings["calibration"] = time.perf_counter() - start
 
     x_max = {(SIMPLIFIED, m): runs[SIMPLIFIED].max_barrel_displacement for m in TABLE2_MASSES}
     for mass in options.masses:
         for label in (MODEL_I, MODEL_II):
             x_max[(label, mass)] = runs[(label, mass)].max_barrel_displacement
     data["x_max"] = x_max
-    if 1000.0 in options.masses:
+    if set(TABLE2_MASSES) <= set(options.masses):  # the claims compare the three masses
         evidence = ClaimEvidence(x_max=x_max, runs={MODEL_I: runs[(MODEL_I, 1000.0)],
                                                     MODEL_II: runs[(MODEL_II, 1000.0)]}, sweeps=sweeps)
         data["claims"] = evaluate_claims(evidence)
@@ -218,7 +245,8 @@ def make_figures(data: dict) -> dict[str, bytes]:
         figures[f"absorber_velocity_{tag}"] = plot_contact_histories(
             pair, "absorber_velocity", title=f"Fig. 10: absorber velocity, m = {mass:g} kg")
         figures[f"first_impact_{tag}"] = plot_first_impact(pair, title=f"Fig. 11: first impact, m = {mass:g} kg")
-    figures["conventions_gap_trend"] = _convention_figure(data)
+    if data["conventions"]:
+        figures["conventions_gap_trend"] = _convention_figure(data)
     return {name: figure_png(fig) for name, fig in figures.items()}
 
 
@@ -268,6 +296,10 @@ def section22_rows(data: dict) -> list[dict]:
     return rows
 
 
+_NOT_STUDIED = ("the readings of the paper and the contact-law calibration were not computed in this run "
+                "(recoil paper --reproduce-only); the full report studies them")
+
+
 def unreproduced(data: dict) -> list[dict]:
     """Every published number we do not reproduce within :data:`REPRODUCED_WITHIN`, with the likely reason."""
     conventions = data["conventions"]
@@ -278,6 +310,8 @@ def unreproduced(data: dict) -> list[dict]:
 
     def best_reading(errors_of: Callable) -> tuple[str, bool]:
         """Text about the reading closest to the paper, and whether it reproduces the number."""
+        if not conventions:
+            return _NOT_STUDIED, True
         err, label, signed, rms = min((abs(errors_of(row)), row.label, errors_of(row), row.rms_error())
                                       for row in conventions)
         text = f"the closest reading of the paper is '{label}' at {signed * 100:+.1f} %"
@@ -312,6 +346,11 @@ def unreproduced(data: dict) -> list[dict]:
             continue
         key = (row["model"], row["quantity"])
         reason = [best_reading(lambda c: c.section22_errors()[key])[0]]
+        if calibration is None:
+            items.append({"published": f"Section 2.2, {row['model']}, {row['quantity'].replace('_', ' ')}",
+                          "paper": row["paper"], "ours": row["ours"], "unit": row["unit"],
+                          "relative_difference": row["relative_difference"], "reason": "; ".join(reason)})
+            continue
         fitted = next((r for r in calibration.residuals if r.get("quantity") == row["quantity"]
                        and row["model"] + ":" in r.get("description", "")), None)
         law = calibration.parameters
@@ -486,18 +525,27 @@ def render_html(data: dict, pngs: dict[str, bytes]) -> str:
                          + [_pct(s2e[(MODEL_I, "peak_contact_force")]), _pct(s2e[(MODEL_I, "max_absorber_velocity")]),
                             f"{row.rms_error() * 100:.1f} %",
                             ", ".join(f"{x * 1e3:.1f}" for x in row.trend()), engine_text])
-    parts.append(_table(["reading", "(i) 100", "(i) 500", "(i) 1000", "(ii) 100", "(ii) 500", "(ii) 1000",
-                         "F (i)", "v (i)", "RMS", "(ii) x_max at 0/40/80 mm [mm]", "engine vs reference"],
-                        conv_rows, table_id="conventions"))
-    parts.append(_img("conventions_gap_trend", pngs["conventions_gap_trend"], "Model (ii) vs gap under each reading"))
+    not_run = ("<p class='note'>Not computed in this run (<code>recoil paper --reproduce-only</code>); "
+               "<code>recoil paper</code> without that option computes it.</p>")
+    if data["conventions"]:
+        parts.append(_table(["reading", "(i) 100", "(i) 500", "(i) 1000", "(ii) 100", "(ii) 500", "(ii) 1000",
+                             "F (i)", "v (i)", "RMS", "(ii) x_max at 0/40/80 mm [mm]", "engine vs reference"],
+                            conv_rows, table_id="conventions"))
+        parts.append(_img("conventions_gap_trend", pngs["conventions_gap_trend"],
+                          "Model (ii) vs gap under each reading"))
+    else:
+        parts.append(not_run)
     # calibration
     calibration = data["calibration"]
     parts.append("<h2 id='calibration'>9. Contact-law calibration on Section 2.2</h2>")
-    parts.append(f"<pre>{_e(calibration.summary())}</pre>")
-    parts.append(_table(["model", "m [kg]", "predicted x_max [m]", "paper [m]", "relative"],
-                        [[_e(r["model"]), f"{r['absorber_mass']:g}", f"{r['max_barrel_displacement']:.4f}",
-                          _fmt(r["published"]), _pct(r["relative_error"])] for r in data["calibration_table2"]],
-                        table_id="calibration-table2"))
+    if calibration is not None:
+        parts.append(f"<pre>{_e(calibration.summary())}</pre>")
+        parts.append(_table(["model", "m [kg]", "predicted x_max [m]", "paper [m]", "relative"],
+                            [[_e(r["model"]), f"{r['absorber_mass']:g}", f"{r['max_barrel_displacement']:.4f}",
+                              _fmt(r["published"]), _pct(r["relative_error"])] for r in data["calibration_table2"]],
+                            table_id="calibration-table2"))
+    else:
+        parts.append(not_run)
     # claims
     parts.append("<h2 id='claims'>10. The paper's qualitative claims</h2>")
     parts.append(_table(["claim", "source", "holds?", "evidence"],
@@ -516,7 +564,13 @@ def render_html(data: dict, pngs: dict[str, bytes]) -> str:
         parts.append(f"<li><b>{_e(item['published'])}</b>{numbers}. {_e(item['reason'])}.</li>")
     parts.append("</ul>")
     timing_rows = [[_e(k), f"{v:.1f} s"] for k, v in data["timings"].items()]
-    parts.append("<h2 id='cost'>12. What this report cost</h2>" + _table(["stage", "wall time"], timing_rows))
+    machine = data.get("machine", {})
+    parts.append("<h2 id='cost'>12. What this report cost</h2>" + _table(["stage", "wall time"], timing_rows)
+                 + (f"<p>{machine.get('cpus')} CPUs, {machine.get('workers')} worker processes, load average "
+                    f"{machine.get('load_average_at_start')} at the start (other programs share the CPUs). The gap "
+                    "sweeps and the convention study stop each run once its peak metrics are proven final by "
+                    "energy bounds (same values as the full 10 s runs); the engine-vs-reference cases and the "
+                    "time histories run the full 10 s.</p>" if machine else ""))
     parts.append("</body></html>")
     return "\n".join(parts)
 
@@ -544,11 +598,12 @@ def results_json(data: dict) -> dict:
         "time_histories": {f"{key[0]}:{key[1]:g}" if isinstance(key, tuple) else key: run.metrics()
                            for key, run in data["runs"].items()},
         "conventions": [row.to_dict() for row in data["conventions"]],
-        "calibration": data["calibration"].to_dict(),
+        "calibration": None if data["calibration"] is None else data["calibration"].to_dict(),
         "calibration_table2": data["calibration_table2"],
         "claims": [v.to_dict() for v in data.get("claims", [])],
         "unreproduced": data["unreproduced"],
         "timings": data["timings"],
+        "machine": data.get("machine"),
     })
 
 

@@ -19,6 +19,11 @@ from mbs_models.scene import Scene
 from . import equations as eq
 from .equations import OFF, ON, Mode, Parameters
 
+#: Why a solve ended (:attr:`ReferenceResult.stop_reason`).
+STOP_END_TIME = "end_time"
+STOP_METRICS_FINAL = "metrics_final"
+STOP_NO_BOUND = "end_time_no_energy_bound"
+_ALL_FINAL = ("max_barrel_displacement", "peak_contact_force", "max_absorber_velocity", "impacts")
 _SUBDIVISIONS = 4
 _STATE_NAMES = ("x_M", "v_M", "x_m", "v_m", "E_recoil_damper", "E_absorber_damper", "E_contact")
 _DISSIPATION_KEYS = ("recoil_damper", "absorber_damper", "contact")
@@ -92,6 +97,9 @@ class ReferenceResult:
     """Dense reference solution of one scene over ``[0, end_time]`` s, with metrics (SI units).
 
     Metrics for the absorber and the contact are ``None`` for the simplified model (no absorber).
+    ``requested_end_time`` is what was asked; ``end_time`` is earlier only when ``stop_when_final``
+    stopped the solve (``stop_reason == "metrics_final"``): then metrics not listed in
+    ``final_metrics`` (and their times; ``impacts`` too) are None, never values of the shorter window.
     """
 
     scene: Scene
@@ -104,10 +112,18 @@ class ReferenceResult:
     impact_threshold: float = 1000.0
     nfev: int = 0
     wall_time: float = 0.0
+    requested_end_time: float | None = None
+    stop_reason: str = STOP_END_TIME
+    final_metrics: tuple[str, ...] = _ALL_FINAL
     _starts: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self):
         self._starts = np.array([s.t0 for s in self.segments])
+        if self.requested_end_time is None:
+            self.requested_end_time = self.end_time
+
+    def _final(self, metric: str) -> bool:
+        return metric in self.final_metrics
 
     # ---------------------------------------------------------------- evaluation
     def _per_segment(self, t, fn: Callable, rows: int | None):
@@ -210,14 +226,14 @@ class ReferenceResult:
         return self._global_max(lambda mode, y: y[0], lambda mode, y: y[1])
 
     @property
-    def max_barrel_displacement(self) -> float:
-        """Largest x_M over [0, end_time] in m."""
-        return self._barrel_max[1]
+    def max_barrel_displacement(self) -> float | None:
+        """Largest x_M over [0, end_time] in m (None if the solve stopped before proving it final)."""
+        return self._barrel_max[1] if self._final("max_barrel_displacement") else None
 
     @property
-    def time_of_max_barrel_displacement(self) -> float:
+    def time_of_max_barrel_displacement(self) -> float | None:
         """Time (s) of :attr:`max_barrel_displacement`."""
-        return self._barrel_max[0]
+        return self._barrel_max[0] if self._final("max_barrel_displacement") else None
 
     @cached_property
     def _absorber_max(self):
@@ -229,12 +245,16 @@ class ReferenceResult:
     @property
     def max_absorber_velocity(self) -> float | None:
         """Largest absorber velocity v_m (m/s); None for the simplified model."""
-        return None if self._absorber_max is None else self._absorber_max[1]
+        if self._absorber_max is None or not self._final("max_absorber_velocity"):
+            return None
+        return self._absorber_max[1]
 
     @property
     def time_of_max_absorber_velocity(self) -> float | None:
         """Time (s) of :attr:`max_absorber_velocity`; None for the simplified model."""
-        return None if self._absorber_max is None else self._absorber_max[0]
+        if self._absorber_max is None or not self._final("max_absorber_velocity"):
+            return None
+        return self._absorber_max[0]
 
     def _force_derivative(self, mode: Mode, y):
         """dF/dt (N/s) in the ON mode: k_c [n p^(n-1) p' s + p^n lambda p'']."""
@@ -271,8 +291,11 @@ class ReferenceResult:
         return list(self._episodes) if self.parameters.has_absorber else None
 
     @property
-    def impacts(self) -> list[ReferenceImpact]:
-        """Contact episodes whose peak force exceeds ``impact_threshold`` N ([] for the simplified model)."""
+    def impacts(self) -> list[ReferenceImpact] | None:
+        """Contact episodes whose peak force exceeds ``impact_threshold`` N ([] for the simplified model;
+        None if the solve stopped before proving the list final)."""
+        if not self._final("impacts"):
+            return None
         return [e for e in self._episodes if e.peak_force > self.impact_threshold]
 
     @cached_property
@@ -287,12 +310,12 @@ class ReferenceResult:
     @property
     def peak_contact_force(self) -> float | None:
         """Largest contact force (N) over [0, end_time]; 0 if never in contact; None without absorber."""
-        return None if self._force_max is None else self._force_max[1]
+        return None if self._force_max is None or not self._final("peak_contact_force") else self._force_max[1]
 
     @property
     def time_of_peak_contact_force(self) -> float | None:
         """Time (s) of :attr:`peak_contact_force`; None without absorber."""
-        return None if self._force_max is None else self._force_max[0]
+        return None if self._force_max is None or not self._final("peak_contact_force") else self._force_max[0]
 
     def metrics(self) -> dict[str, Any]:
         """The DESIGN.md metric set as plain Python values (impacts as dicts)."""
@@ -303,8 +326,13 @@ class ReferenceResult:
             "time_of_peak_contact_force": self.time_of_peak_contact_force,
             "max_absorber_velocity": self.max_absorber_velocity,
             "time_of_max_absorber_velocity": self.time_of_max_absorber_velocity,
-            "impacts": [{"start": i.start, "end": i.end, "peak_force": i.peak_force,
-                         "time_of_peak": i.time_of_peak} for i in self.impacts],
+            "impacts": None if self.impacts is None else [
+                {"start": i.start, "end": i.end, "peak_force": i.peak_force, "time_of_peak": i.time_of_peak}
+                for i in self.impacts],
+            "end_time": self.end_time,
+            "requested_end_time": self.requested_end_time,
+            "stop_reason": self.stop_reason,
+            "final_metrics": list(self.final_metrics),
             "dissipated_energy": self.dissipated_energy,
             "wall_time": self.wall_time,
         }

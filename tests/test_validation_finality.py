@@ -1,0 +1,191 @@
+"""Early stop of the reference (solve_reference(stop_when_final=...), validation.finality).
+
+Same contract as the engine's: the metrics of an early-stopped reference are the full run's (to
+round-off: the solver's steps before the stop are the same), unproven ones are None, and the bounds
+really bound the future of the dense solution.  The two independent bound implementations agree.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mbs_models import Conventions, model_i, model_ii, simplified_model
+from validation import equations as eq
+from validation import finality
+from validation.reference import solve_reference
+
+REPO = Path(__file__).resolve().parent.parent
+ALL = finality.METRICS
+STUDIED = ("max_barrel_displacement", "peak_contact_force", "max_absorber_velocity")
+TIMES = {"max_barrel_displacement": "time_of_max_barrel_displacement",
+         "peak_contact_force": "time_of_peak_contact_force",
+         "max_absorber_velocity": "time_of_max_absorber_velocity"}
+END = 8.0  # s: long enough for every stop below (model (i) proves its impacts final at 6.8 s)
+
+FAST = {
+    "simplified": simplified_model(),
+    "i-m1000-gap0": model_i(1000.0, 0.0),
+    "ii-m1000-gap0": model_ii(1000.0, 0.0),
+    "ii-m100-gap120mm": model_ii(100.0, 0.12),
+    "ii-literal_gap_sign": model_ii(1000.0, 0.04, Conventions(literal_gap_sign=True)),
+    "ii-compression_only": model_ii(1000.0, 0.0, Conventions(compression_only=True)),
+}
+SLOW = {
+    **{f"{name}-m{mass:g}-gap{gap * 1e3:g}mm": factory(mass, gap)
+       for name, factory in (("i", model_i), ("ii", model_ii)) for mass in (100.0, 500.0, 1000.0)
+       for gap in (0.0, 0.04, 0.08, 0.12)},
+    "ii-soft": model_ii(1000.0, 0.0).with_changes(**{"contact.stiffness": 1e6, "contact.exponent": 1.0}),
+    "i-stiff": model_i(100.0, 0.0).with_changes(**{"contact.stiffness": 1e10}),
+    **{f"i-{flag}": model_i(500.0, 0.02, Conventions(**{flag: True}))
+       for flag in ("compression_only", "v0_includes_absorber", "rounded_initial_velocity", "literal_gap_sign")},
+}
+
+
+def _assert_same_as_full(early, full):
+    for name in early.final_metrics:
+        if name == "impacts":
+            assert [(i.start, i.end) for i in early.impacts] == [(i.start, i.end) for i in full.impacts]
+            np.testing.assert_allclose([i.peak_force for i in early.impacts], [i.peak_force for i in full.impacts],
+                                       rtol=1e-12)
+            continue
+        ours, theirs = getattr(early, name), getattr(full, name)
+        if theirs is None:  # no absorber
+            assert ours is None
+            continue
+        assert ours == pytest.approx(theirs, rel=1e-12, abs=1e-300), name
+        assert getattr(early, TIMES[name]) == pytest.approx(getattr(full, TIMES[name]), rel=1e-12, abs=1e-15)
+    for name in set(ALL) - set(early.final_metrics):
+        assert getattr(early, name) is None, name
+
+
+_FULL: dict = {}
+
+
+def _full(scene):
+    """The run to END without early stop (cached: three requests compare against it)."""
+    if scene not in _FULL:
+        _FULL[scene] = solve_reference(scene, END)
+    return _FULL[scene]
+
+
+def _check(scene, requested):
+    full = _full(scene)
+    early = solve_reference(scene, END, stop_when_final=requested)
+    assert early.requested_end_time == END
+    if early.stop_reason == "metrics_final":
+        assert set(requested) <= set(early.final_metrics) and early.end_time < END
+        assert len(early.segments) <= len(full.segments)
+        for a, b in zip(early.segments[:-1], full.segments):  # the same segments before the stop
+            assert (a.t0, a.t1, a.mode) == (b.t0, b.t1, b.mode)
+    else:
+        assert early.stop_reason == "end_time" and early.end_time == END
+    _assert_same_as_full(early, full)
+    return early
+
+
+@pytest.mark.parametrize("requested", [("max_barrel_displacement",), STUDIED, ALL], ids=["x", "x-F-v", "all"])
+@pytest.mark.parametrize("key", list(FAST))
+def test_early_stopped_reference_gives_the_full_runs_metrics(key, requested):
+    early = _check(FAST[key], requested)
+    if key != "ii-literal_gap_sign" or requested != ALL:  # an interference keeps a contact force for ever
+        assert early.stop_reason == "metrics_final"
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("requested", [("max_barrel_displacement",), STUDIED, ALL], ids=["x", "x-F-v", "all"])
+@pytest.mark.parametrize("key", list(SLOW))
+def test_early_stopped_reference_gives_the_full_runs_metrics_grid(key, requested):
+    _check(SLOW[key], requested)
+
+
+def test_literal_lambda_sign_runs_to_the_end():
+    scene = model_ii(1000.0, 0.0, Conventions(literal_lambda_sign=True))
+    early = solve_reference(scene, 2.0, stop_when_final=ALL)
+    assert early.stop_reason == "end_time_no_energy_bound" and early.end_time == 2.0
+    assert early.final_metrics == ALL and early.impacts is not None
+
+
+def test_unproven_metrics_are_none():
+    early = solve_reference(model_ii(1000.0, 0.0), END, stop_when_final=("max_barrel_displacement",))
+    assert early.stop_reason == "metrics_final"
+    assert early.impacts is None and early.peak_contact_force is None and early.time_of_peak_contact_force is None
+    metrics = early.metrics()
+    assert metrics["impacts"] is None and metrics["end_time"] < metrics["requested_end_time"]
+
+
+@pytest.mark.parametrize("bad", ["impacts", ["max_displacement"]])
+def test_bad_metric_names(bad):
+    with pytest.raises(ValueError, match="stop_when_final.*allowed: max_barrel_displacement"):
+        solve_reference(model_ii(), 1.0, stop_when_final=bad)
+
+
+@pytest.mark.parametrize("key", ["i-m1000-gap0", "ii-m1000-gap0", "ii-m100-gap120mm", "ii-literal_gap_sign",
+                                 "ii-compression_only"])
+def test_the_bounds_bound_the_future_of_the_dense_solution(key):
+    scene = FAST[key]
+    result = _full(scene)
+    P = result.parameters
+    t = np.linspace(0.0, END, 6001)
+    y = result.state(t)
+    energy = finality.mechanical_energy(P, y)
+    rise = np.maximum.accumulate(energy[::-1])[::-1] - energy
+    assert np.all(rise <= 1e-9 * energy + 1e-12), "the reference's energy must never increase"
+    force = result.contact_force(t)
+    later = {"x_M": y[0], "v_m": np.abs(y[3]), "relative": y[0] - y[2],
+             "p": np.maximum(y[0] - y[2] - P.gap_offset, 0.0), "p_rate": np.abs(y[1] - y[3]), "force": force}
+    later = {k: np.maximum.accumulate(v[::-1])[::-1] for k, v in later.items()}
+    bounds = [finality.bounds(P, float(e) * (1 + 1e-9)) for e in energy]
+    for name, values in later.items():
+        b = np.array([x[name] for x in bounds])
+        assert np.all(values <= b * (1 + 1e-12) + 1e-12), name
+
+
+@pytest.mark.parametrize("scene", [model_i(100.0, 0.0), model_ii(500.0, 0.04),
+                                   model_ii(1000.0, 0.02, Conventions(literal_gap_sign=True)),
+                                   model_i(1000.0, 0.08).with_changes(**{"contact.exponent": 1.0}),
+                                   simplified_model()], ids=["i", "ii", "ii-literal-gap", "i-linear", "simplified"])
+def test_the_two_independent_implementations_agree(scene):
+    from mbs_models.final_metrics import EnergyBounds
+
+    engine = EnergyBounds(scene)
+    P = eq.Parameters.from_scene(scene)
+    rng = np.random.default_rng(4)
+    for _ in range(200):
+        x_M, v_M, x_m, v_m = rng.normal(0.0, [0.1, 0.5, 0.1, 0.5])
+        if scene.absorber is None:
+            x_m = v_m = 0.0
+        y = np.array([x_M, v_M, x_m, v_m, 0.0, 0.0, 0.0])
+        energy = float(finality.mechanical_energy(P, y))
+        assert engine.energy(x_M, v_M, x_m, v_m) == pytest.approx(energy, rel=1e-12)
+        ours = finality.bounds(P, energy)
+        assert engine.barrel_displacement(energy) == pytest.approx(ours["x_M"], rel=1e-12)
+        if scene.absorber is None:
+            continue
+        assert engine.absorber_velocity(energy) == pytest.approx(ours["v_m"], rel=1e-12)
+        assert engine.relative_displacement(energy) == pytest.approx(ours["relative"], rel=1e-12)
+        assert engine.contact_reachable(energy) == bool(ours["reachable"])
+        assert engine.penetration(energy) == pytest.approx(ours["p"], rel=1e-12, abs=1e-300)
+        assert engine.penetration_rate(energy) == pytest.approx(ours["p_rate"], rel=1e-12)
+        assert engine.contact_force_bound(energy) == pytest.approx(ours["force"], rel=1e-12, abs=1e-300)
+
+
+def test_validation_still_imports_no_engine_code():
+    code = ("import sys, validation.reference, validation.finality\n"
+            "bad = [m for m in sys.modules if m == 'exudyn' or m.startswith('exudyn.') or m in "
+            "('mbs_models.simulation', 'mbs_models.final_metrics', 'mbs_models.forces', 'mbs_models.result')]\n"
+            "print(bad)\nsys.exit(1 if bad else 0)\n")
+    env = dict(os.environ, PYTHONPATH=str(REPO) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    out = subprocess.run([sys.executable, "-c", code], cwd=REPO, env=env, capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stdout + out.stderr
+
+
+def test_zero_stiffness_means_no_bound():
+    P = eq.Parameters.from_scene(simplified_model().with_changes(**{"recoil_spring.stiffness": 0.0}))
+    assert finality.bounds(P, 1.0)["x_M"] == math.inf
