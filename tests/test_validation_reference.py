@@ -296,3 +296,34 @@ def test_paper_case_m1000_gap0(model):
         assert r.max_barrel_displacement == pytest.approx(0.2066, abs=5e-4)
     assert 115e3 < r.peak_contact_force < 130e3
     assert first.start == 0.0 and 0.012 < first.end < 0.018
+
+
+@pytest.mark.parametrize("scene", [simplified_model(), model_i(500.0, 0.01), model_ii(100.0, 0.0),
+                                   model_ii(1000.0, 0.02, Conventions(literal_gap_sign=True, literal_lambda_sign=True))],
+                         ids=["simplified", "i", "ii", "ii-literal"])
+def test_rhs_is_the_equations_written_out(scene):
+    """The fast scalar right-hand side equals the equations' building blocks (accelerations from
+    other_forces / raw_contact_force, dissipated powers c v^2, c_r v_rel^2 and (F - k_c p^n) p') in
+    every mode, bit for bit, on random states."""
+    from validation import equations as eq
+
+    P = eq.Parameters.from_scene(scene)
+    rng = np.random.default_rng(7)
+    for contact in (eq.OFF, eq.ON, eq.STICK) if P.has_absorber else (eq.OFF,):
+        for recoil in (True, False):
+            for penetrated in (False, True):
+                mode = eq.Mode(contact=contact, recoil=recoil, penetrated=penetrated)
+                for _ in range(200):
+                    y = rng.normal(size=7) * np.array([0.05, 1.0, 0.05, 1.0, 10.0, 10.0, 10.0])
+                    a_M, a_m = eq.accelerations(P, y, mode)
+                    F = eq.raw_contact_force(P, y, mode)
+                    expected = [y[1], a_M, y[3], a_m if P.has_absorber else 0.0, mode.damping(P) * y[1] ** 2]
+                    if P.has_absorber:
+                        _, rel_v = eq.absorber_relative(P, y)
+                        p, pd = eq.penetration(P, y), eq.penetration_rate(P, y)
+                        elastic = P.kc * eq.signed_power(p, P.n) if (penetrated or contact != eq.OFF) else 0.0
+                        expected += [P.cr * rel_v ** 2, (F - elastic) * pd]
+                    else:
+                        expected += [0.0, 0.0]
+                    np.testing.assert_array_equal(eq.rhs(P, mode, 0.0, y), np.array(expected, dtype=float),
+                                                  err_msg=str((contact, recoil, penetrated, y)))
