@@ -198,7 +198,7 @@ def rhs(P: Parameters, mode: Mode, t, y):
     scalar arithmetic made it 5x slower).  ``tests/test_validation_reference.py`` checks the two
     forms against each other.
     """
-    x_M, v_M, x_m, v_m = y[0].item(), y[1].item(), y[2].item(), y[3].item()
+    x_M, v_M, x_m, v_m = y[:4].tolist()
     c = P.c_recoil if mode.recoil else P.c_counter
     f_M = -P.k * x_M - c * v_M
     d_rec = c * v_M ** 2
