@@ -15,10 +15,12 @@ import base64
 import html
 import json
 import math
+import multiprocessing
 import os
 import time
 import warnings
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 from typing import Callable
 
@@ -230,24 +232,54 @@ def _convention_figure(data: dict):
     return fig
 
 
-def make_figures(data: dict) -> dict[str, bytes]:
-    """Every figure of the report as PNG bytes, keyed by file stem."""
+#: (file stem, zero-argument figure builder) of the figures being rendered; forked workers read it
+_PENDING_FIGURES: list[tuple[str, Callable]] = []
+
+
+def _render_pending(index: int) -> bytes:
+    """PNG bytes of the ``index``-th pending figure (runs in a forked worker)."""
+    return figure_png(_PENDING_FIGURES[index][1]())
+
+
+def figure_builders(data: dict) -> list[tuple[str, Callable]]:
+    """Every figure of the report as (file stem, zero-argument builder returning a Figure)."""
     runs = data["runs"]
-    figures = {"fig4_gap_sweep_model_i": _sweep_figure(data, MODEL_I, 4),
-               "fig5_gap_sweep_model_ii": _sweep_figure(data, MODEL_II, 5)}
+    builders = [("fig4_gap_sweep_model_i", partial(_sweep_figure, data, MODEL_I, 4)),
+                ("fig5_gap_sweep_model_ii", partial(_sweep_figure, data, MODEL_II, 5))]
     for mass in data["options"]["masses"]:
         pair = [runs[(MODEL_I, mass)], runs[(MODEL_II, mass)]]
         tag = f"m{mass:g}"
-        figures[f"barrel_displacement_{tag}"] = plot_barrel_displacements(
-            [runs[SIMPLIFIED], *pair], title=f"Figs 6-8: barrel displacement, m = {mass:g} kg, gap 0")
-        figures[f"contact_force_{tag}"] = plot_contact_histories(
-            pair, "contact_force", title=f"Fig. 9: contact force between absorber and wall A, m = {mass:g} kg")
-        figures[f"absorber_velocity_{tag}"] = plot_contact_histories(
-            pair, "absorber_velocity", title=f"Fig. 10: absorber velocity, m = {mass:g} kg")
-        figures[f"first_impact_{tag}"] = plot_first_impact(pair, title=f"Fig. 11: first impact, m = {mass:g} kg")
+        builders += [
+            (f"barrel_displacement_{tag}", partial(plot_barrel_displacements, [runs[SIMPLIFIED], *pair],
+                                                   title=f"Figs 6-8: barrel displacement, m = {mass:g} kg, gap 0")),
+            (f"contact_force_{tag}", partial(plot_contact_histories, pair, "contact_force",
+                                             title=f"Fig. 9: contact force between absorber and wall A, m = {mass:g} kg")),
+            (f"absorber_velocity_{tag}", partial(plot_contact_histories, pair, "absorber_velocity",
+                                                 title=f"Fig. 10: absorber velocity, m = {mass:g} kg")),
+            (f"first_impact_{tag}", partial(plot_first_impact, pair, title=f"Fig. 11: first impact, m = {mass:g} kg")),
+        ]
     if data["conventions"]:
-        figures["conventions_gap_trend"] = _convention_figure(data)
-    return {name: figure_png(fig) for name, fig in figures.items()}
+        builders.append(("conventions_gap_trend", partial(_convention_figure, data)))
+    return builders
+
+
+def make_figures(data: dict, workers: int | None = None) -> dict[str, bytes]:
+    """Every figure of the report as PNG bytes, keyed by file stem.
+
+    Rendering (matplotlib, ~0.4 s a figure) is spread over ``workers`` processes (default: all CPUs)
+    where processes can be forked -- the workers inherit the figure data instead of receiving it
+    pickled; elsewhere, or with ``workers=1``, the figures are rendered here one by one.
+    """
+    global _PENDING_FIGURES
+    builders = figure_builders(data)
+    if workers == 1 or "fork" not in multiprocessing.get_all_start_methods():
+        return {name: figure_png(build()) for name, build in builders}
+    _PENDING_FIGURES = builders
+    try:
+        pngs = parallel_map(_render_pending, range(len(builders)), workers=workers)
+    finally:
+        _PENDING_FIGURES = []
+    return {name: png for (name, _), png in zip(builders, pngs)}
 
 
 # --------------------------------------------------------------------------------------------- tables
@@ -614,7 +646,7 @@ def write_report(out: str | Path, options: ReportOptions = ReportOptions(), prog
     data = compute_report(options, progress)
     progress("figures and report")
     data["unreproduced"] = unreproduced(data)
-    pngs = make_figures(data)
+    pngs = make_figures(data, options.workers)
     from mbs_models.outputs import atomic_write_bytes
     for name, png in pngs.items():
         atomic_write_bytes(out / f"{name}.png", png)
