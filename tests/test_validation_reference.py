@@ -327,3 +327,14 @@ def test_rhs_is_the_equations_written_out(scene):
                         expected += [0.0, 0.0]
                     np.testing.assert_array_equal(eq.rhs(P, mode, 0.0, y), np.array(expected, dtype=float),
                                                   err_msg=str((contact, recoil, penetrated, y)))
+
+
+def test_rhs_overflow_gives_inf_like_numpy():
+    """A rejected trial step can visit absurd states: the right-hand side must give inf there (so the
+    integrator shrinks the step), as numpy arithmetic does, not raise OverflowError."""
+    from validation import equations as eq
+
+    P = eq.Parameters.from_scene(model_ii(1.0, 0.0).with_changes(**{"contact.stiffness": 1e12}))
+    mode = eq.Mode(contact=eq.ON, recoil=True, penetrated=True)
+    dy = eq.rhs(P, mode, 0.0, np.array([1e200, 1e200, -1e200, 0.0, 0.0, 0.0, 0.0]))
+    assert dy.shape == (7,) and not np.all(np.isfinite(dy))
