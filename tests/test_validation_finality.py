@@ -189,3 +189,12 @@ def test_validation_still_imports_no_engine_code():
 def test_zero_stiffness_means_no_bound():
     P = eq.Parameters.from_scene(simplified_model().with_changes(**{"recoil_spring.stiffness": 0.0}))
     assert finality.bounds(P, 1.0)["x_M"] == math.inf
+
+
+def test_stop_event_root_on_the_wrong_side_of_the_bound_still_stops():
+    """Regression: model (ii), m = 500 kg, gap 120 mm, all metrics: the stop event's root left the
+    force bound 1.005e-12 (relative) short of the impact threshold, the check refused it, and the
+    solve restarted at the same instant until it failed as 'stuck'."""
+    early = solve_reference(model_ii(500.0, 0.12), END, stop_when_final=ALL)
+    assert early.stop_reason == "metrics_final" and early.final_metrics == ALL
+    assert early.end_time == pytest.approx(1.5532, abs=1e-3)
