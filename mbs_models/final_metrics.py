@@ -62,6 +62,7 @@ import math
 from typing import Iterable
 
 from .errors import SceneError
+from .forces import hunt_crossley_force
 from .scene import Scene
 
 #: Metrics that can be proven final before the end time (names of :class:`~mbs_models.result.Result` fields).
@@ -129,23 +130,14 @@ class EnergyBounds:
         self.gap_offset = -contact.gap if scene.conventions.literal_gap_sign else contact.gap
         self._k_c, self._n = contact.stiffness, contact.exponent
         self._elastic = (contact.exponent + 1.0) / contact.stiffness     # p^(n+1) <= (n+1) E / k_c
-        self._damping = -contact.damping_factor if scene.conventions.literal_lambda_sign else contact.damping_factor
         self._lambda = contact.damping_factor
-        self._compression_only = scene.conventions.compression_only
 
     # ---------------------------------------------------------------------------- the state
     def contact_force(self, relative_position: float, relative_velocity: float) -> float:
-        """Hunt-Crossley force in N (>= 0) for ``x_M - x_m`` (m) and ``p' = v_M - v_m`` (m/s).
-
-        The law of :func:`mbs_models.forces.hunt_crossley_force` (with the conventions), for floats.
-        """
-        p = relative_position - self.gap_offset
-        if p <= 0.0:
-            return 0.0
-        force = self._k_c * p ** self._n * (1.0 + self._damping * relative_velocity)
-        if force <= 0.0 or (self._compression_only and not relative_velocity > 0.0):
-            return 0.0
-        return force
+        """Hunt-Crossley force in N (>= 0) for ``x_M - x_m`` (m) and ``p' = v_M - v_m`` (m/s):
+        :func:`mbs_models.forces.hunt_crossley_force` with the scene's conventions."""
+        return hunt_crossley_force(relative_position, relative_velocity, self.scene.contact,
+                                   self.scene.conventions)
 
     def energy(self, x_M: float, v_M: float, x_m: float = 0.0, v_m: float = 0.0) -> float:
         """E in J at the state (m, m/s): kinetic + springs + contact elastic energy."""

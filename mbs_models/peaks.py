@@ -42,6 +42,24 @@ class HermiteTrajectory:
                        t0 + f * (t1 - t0))
 
 
+def runs_of_true(flags: np.ndarray) -> list[tuple[int, int]]:
+    """``(first, last)`` indices (inclusive) of every maximal run of True in a 1-D boolean array.
+
+    The contact episodes of a sampled force are ``runs_of_true(force > 0)``.
+    """
+    active = np.asarray(flags, dtype=bool)
+    if not active.any():
+        return []
+    edges = np.diff(active.astype(np.int8))
+    starts = list(np.flatnonzero(edges == 1) + 1)
+    ends = list(np.flatnonzero(edges == -1))
+    if active[0]:
+        starts.insert(0, 0)
+    if active[-1]:
+        ends.append(len(active) - 1)
+    return [(int(i0), int(i1)) for i0, i1 in zip(starts, ends)]
+
+
 def refine_maximum(time: np.ndarray, y: np.ndarray, dy: np.ndarray) -> tuple[float, float]:
     """Global maximum ``(value, time)`` of the Hermite interpolant of ``y`` (derivative ``dy``).
 

@@ -10,7 +10,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import forces
-from .peaks import HermiteTrajectory, refine_crossing, refine_function_maximum, refine_maximum
+from .final_metrics import FINAL_METRICS
+from .peaks import HermiteTrajectory, refine_crossing, refine_function_maximum, refine_maximum, runs_of_true
 from .result import Impact
 from .scene import Scene
 
@@ -55,22 +56,12 @@ def find_impacts(scene: Scene, s: Samples, contact_force: np.ndarray, interp: _I
                  threshold: float) -> list[Impact]:
     """Contact episodes (maximal intervals with force > 0) whose peak exceeds ``threshold`` (N)."""
     t = s.time
-    active = contact_force > 0.0
     impacts: list[Impact] = []
-    if not active.any():
-        return impacts
-    edges = np.diff(active.astype(np.int8))
-    starts = list(np.flatnonzero(edges == 1) + 1)
-    ends = list(np.flatnonzero(edges == -1))
-    if active[0]:
-        starts.insert(0, 0)
-    if active[-1]:
-        ends.append(len(t) - 1)
 
     def force_positive(times: np.ndarray) -> np.ndarray:
         return contact_force_at(scene, interp, times) > 0.0
 
-    for i0, i1 in zip(starts, ends):
+    for i0, i1 in runs_of_true(contact_force > 0.0):
         k = i0 + int(np.argmax(contact_force[i0:i1 + 1]))
         peak, t_peak = refine_function_maximum(lambda x: contact_force_at(scene, interp, x), t, k)
         peak = max(peak, float(contact_force[k]))
@@ -145,12 +136,8 @@ class Metrics:
     kinetic_energy_history: np.ndarray | None = None
 
 
-#: Every metric :func:`analyse` can compute.
-ALL_METRICS = ("max_barrel_displacement", "peak_contact_force", "max_absorber_velocity", "impacts")
-
-
 def analyse(scene: Scene, s: Samples, contact_force: np.ndarray | None, impact_threshold: float,
-            wanted: tuple[str, ...] = ALL_METRICS) -> Metrics:
+            wanted: tuple[str, ...] = FINAL_METRICS) -> Metrics:
     """Compute the metrics of a solve from its samples: those in ``wanted``, and always the energies.
 
     Metrics left out are None (the contact force peak and the impacts share one search: asking for

@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 
 from .accuracy import SolverSettings
+from .final_metrics import FINAL_METRICS
 from .scene import Scene
 
 
@@ -83,8 +84,7 @@ class Result:
     steps: int = 0
     requested_end_time: float | None = None
     stop_reason: str = "end_time"
-    final_metrics: tuple[str, ...] = ("max_barrel_displacement", "peak_contact_force", "max_absorber_velocity",
-                                      "impacts")
+    final_metrics: tuple[str, ...] = FINAL_METRICS
 
     def __post_init__(self):
         if self.requested_end_time is None:

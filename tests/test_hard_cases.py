@@ -23,6 +23,7 @@ import pytest
 
 from mbs_models import Conventions, model_i, model_ii, simulate
 from mbs_models.scene import Scene
+from validation.closed_form import simplified_max_displacement
 from validation.reference import solve_reference
 
 #: Largest errors accepted per preset: a margin over the maxima measured on :data:`HARD_CASES` and on
@@ -45,13 +46,8 @@ THRESHOLD_BAND = 1e-2
 
 def free_barrel_maximum(scene: Scene) -> float:
     """First maximum (m) of the barrel on its spring and recoil damper alone (no absorber)."""
-    M, k, c = scene.barrel.mass, scene.recoil_spring.stiffness, scene.recoil_damper.recoil
-    v0 = scene.initial_velocity
-    wn = math.sqrt(k / M)
-    zeta = c / (2.0 * math.sqrt(k * M))
-    wd = wn * math.sqrt(1.0 - zeta ** 2)
-    t_max = math.atan2(wd, zeta * wn) / wd
-    return v0 / wd * math.exp(-zeta * wn * t_max) * math.sin(wd * t_max)
+    return simplified_max_displacement(scene.barrel.mass, scene.recoil_spring.stiffness,
+                                       scene.recoil_damper.recoil, scene.initial_velocity)[0]
 
 
 X_FREE = free_barrel_maximum(model_ii())  # 0.2214770 m, the simplified model's Table 2 value

@@ -65,6 +65,7 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import minimize_scalar
 
 from mbs_models.models import model_i, model_ii, simplified_model
+from mbs_models.peaks import runs_of_true
 from mbs_models.scene import Scene
 
 from .equations import Parameters
@@ -435,16 +436,8 @@ def solve_plain(scene: Scene, end_time: float, method: str, rtol: float, atol: f
         def force_at(s: float) -> float:
             return float(plain_contact_force(P, dense(s)[:, None])[0])
 
-        active = (force > 0).astype(np.int8)
-        edges = np.diff(active)
-        starts = list(np.flatnonzero(edges == 1) + 1)
-        ends = list(np.flatnonzero(edges == -1))
-        if active[0]:
-            starts.insert(0, 0)
-        if active[-1]:
-            ends.append(len(grid) - 1)
         force_max = 0.0
-        for i0, i1 in zip(starts, ends):
+        for i0, i1 in runs_of_true(force > 0):
             k = i0 + int(np.argmax(force[i0:i1 + 1]))
             peak = _refined_max(force_at, grid, force, k)
             force_max = max(force_max, peak)
