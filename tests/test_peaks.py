@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from mbs_models.peaks import HermiteTrajectory, refine_crossing, refine_function_maximum, refine_maximum
+from mbs_models.peaks import HermiteTrajectory, refine_crossing, refine_function_maximum, refine_maximum, runs_of_true
 
 
 def test_hermite_reproduces_cubics_exactly():
@@ -38,3 +38,11 @@ def test_refine_crossing_finds_switch_time():
     switch = 0.123456789
     found = refine_crossing(lambda x: x >= switch, 0.1, 0.2)
     assert found == pytest.approx(switch, abs=1e-9)
+
+
+@pytest.mark.parametrize("flags, runs", [
+    ([], []), ([0, 0, 0], []), ([1, 1, 1], [(0, 2)]), ([1, 0, 0], [(0, 0)]), ([0, 0, 1], [(2, 2)]),
+    ([0, 1, 1, 0, 1, 0, 0, 1, 1], [(1, 2), (4, 4), (7, 8)]),
+])
+def test_runs_of_true(flags, runs):
+    assert runs_of_true(np.array(flags, dtype=bool)) == runs
