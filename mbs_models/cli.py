@@ -64,7 +64,7 @@ def _cmd_run(args) -> int:
 
 
 def _cmd_paper(args) -> int:
-    from validation.report import ReportOptions, table2_markdown, table2_rows, write_report
+    from validation.studies.report import ReportOptions, table2_markdown, table2_rows, write_report
 
     if args.workers is not None and args.workers < 1:
         raise SceneError("--workers", f"must be >= 1, got {args.workers}")
@@ -88,7 +88,7 @@ def _cmd_paper(args) -> int:
 
 
 def _cmd_validate(args) -> int:
-    from validation.compare import compare
+    from validation.studies.compare import compare
 
     scene = _resolve_scene(args.scene)
     comparison = compare(scene, args.end_time, args.accuracy, impact_threshold=args.impact_threshold)
@@ -100,7 +100,7 @@ def _cmd_validate(args) -> int:
 
 
 def _cmd_precision(args) -> int:
-    from validation.precision import preset_study, run_study
+    from validation.studies.precision import preset_study, run_study
 
     from .outputs import prepare_output_dir
 

@@ -8,8 +8,8 @@
 What it measures (not a timed test: the numbers depend on the machine; the ratios much less so):
 
 1. **Against scipy LSODA at equal accuracy**: the ``standard`` preset's errors (max barrel displacement,
-   peak contact force, max absorber velocity) against a tight truth (:func:`validation.precision.compute_truth`);
-   then the loosest LSODA tolerance (on the same equations, :func:`validation.precision.solve_plain`) whose
+   peak contact force, max absorber velocity) against a tight truth (:func:`validation.studies.precision.compute_truth`);
+   then the loosest LSODA tolerance (on the same equations, :func:`validation.studies.precision.solve_plain`) whose
    worst error is no larger; ratio of median wall times, complete runs and integration alone.
 2. **Against a compiled fixed-structure yardstick**: ``scripts/recoil_dopri5.c``, the same equations and
    the same adaptive scheme (Dormand-Prince 5(4), Hairer's step control) at the preset's rtol, atol and
@@ -130,7 +130,7 @@ class CompiledDopri5:
 
     def prepare(self, scene, end_time: float, rtol: float, atol: float, max_step: float):
         """Allocate once; return a zero-argument callable that integrates and returns the sample count."""
-        from validation.equations import Parameters
+        from validation.reference.equations import Parameters
 
         P = Parameters.from_scene(scene)
         params = np.array([P.M, P.k, P.c_recoil, P.c_counter, float(P.has_absorber), P.m, float(P.on_barrel), P.kr,
@@ -208,7 +208,7 @@ def main(argv=None) -> int:
     from mbs_models.cli import _resolve_scene
     from mbs_models import simulate
     from mbs_models.accuracy import ACCURACY_PRESETS
-    from validation.precision import (PRESET_METRICS, RunValues, _engine_values, compute_truth, relative_errors,
+    from validation.studies.precision import (PRESET_METRICS, RunValues, _engine_values, compute_truth, relative_errors,
                                       solve_plain)
 
     scene = _resolve_scene(args.scene)
@@ -256,8 +256,8 @@ def main(argv=None) -> int:
         count = compiled_run()
         from mbs_models.peaks import HermiteTrajectory
         from mbs_models.postprocess import analyse
-        from validation.equations import Parameters
-        from validation.precision import plain_contact_force
+        from validation.reference.equations import Parameters
+        from validation.studies.precision import plain_contact_force
 
         samples = yardstick.samples(count)
         force = None

@@ -3,7 +3,7 @@
 Measured worst error of e over the grid below: 2.8e-6 at `standard`, 1e-9 at `reference`.
 
 For two free bodies (no springs, no dampers) the coefficient of restitution depends only on
-lambda * v_in (``validation.closed_form.hunt_crossley_restitution`` derives it from the energy-like
+lambda * v_in (``validation.reference.closed_form.hunt_crossley_restitution`` derives it from the energy-like
 integral over one impact), whatever the stiffness, exponent or masses.  The reference is checked
 against the same oracle in test_validation_reference.py.
 """
@@ -14,7 +14,7 @@ import pytest
 
 from mbs_models import (Absorber, Barrel, Contact, Conventions, RecoilDamper, RecoilSpring, Scene, SolverSettings,
                         simulate)
-from validation.closed_form import hunt_crossley_restitution
+from validation.reference.closed_form import hunt_crossley_restitution
 
 IMPACT_VELOCITY = 0.69  # m/s
 

@@ -11,8 +11,8 @@ import pytest
 
 from mbs_models import model_i, model_ii, simplified_model
 from mbs_models.cli import main
-from validation import equations as eq
-from validation.precision import (FAILED_STATUSES, METRICS, TARGETS, RunValues, Setting, Study, _exudyn, _scipy,
+from validation.reference import equations as eq
+from validation.studies.precision import (FAILED_STATUSES, METRICS, TARGETS, RunValues, Setting, Study, _exudyn, _scipy,
                                   classify_failure, compute_truth, impact_mismatch, plain_rhs, run_study)
 
 END_TIME = 1.0  # the first impacts of model (ii), m = 1000 kg, gap 0, happen in the first second
@@ -98,7 +98,7 @@ def test_simplified_scene_has_no_contact_metrics():
 
 @pytest.mark.parametrize("scene", [model_i(500.0, 0.0), model_ii(100.0, 0.01)], ids=["model-i", "model-ii"])
 def test_plain_rhs_is_the_reference_equations(scene):
-    """scipy's plain right-hand side equals validation.equations' in the mode the state is in."""
+    """scipy's plain right-hand side equals validation.reference.equations' in the mode the state is in."""
     P = eq.Parameters.from_scene(scene)
     f = plain_rhs(P)
     rng = np.random.default_rng(1)

@@ -1,4 +1,4 @@
-"""Each accuracy preset meets the error it states (validation.precision.PRESET_ERROR_BOUNDS, the README's
+"""Each accuracy preset meets the error it states (validation.studies.precision.PRESET_ERROR_BOUNDS, the README's
 "Accuracy presets" table) against a tight reference computed once per paper case.
 
 The default run checks the cases where the study measured each preset's worst errors; ``-m slow`` checks
@@ -10,8 +10,8 @@ from __future__ import annotations
 import pytest
 
 from mbs_models.accuracy import ACCURACY_PRESETS
-from validation.compare import DEFAULT_TOLERANCES
-from validation.precision import PRESET_ERROR_BOUNDS, PRESET_METRICS, paper_cases, preset_study
+from validation.studies.compare import DEFAULT_TOLERANCES
+from validation.studies.precision import PRESET_ERROR_BOUNDS, PRESET_METRICS, paper_cases, preset_study
 
 #: The paper cases where the preset study found the largest errors of the presets (draft: displacement on
 #: model-ii-m1000-gap80mm, force and absorber velocity on model-i-m500-gap40mm; standard: model-ii-m1000-gap40mm,

@@ -1,4 +1,4 @@
-"""Contact-law calibration (validation.calibration): recovery, subsets, engine forward model, bad inputs,
+"""Contact-law calibration (validation.studies.calibration): recovery, subsets, engine forward model, bad inputs,
 identifiability, and the Section 2.2 application (reported, not tuned)."""
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ import pytest
 
 from mbs_models import SceneError, model_i, model_ii
 from mbs_models.models import PAPER_CONTACT_DAMPING_FACTOR, PAPER_CONTACT_EXPONENT, PAPER_CONTACT_STIFFNESS
-from validation.calibration import (CalibrationWarning, Observation, calibrate_contact, default_end_time,
+from validation.studies.calibration import (CalibrationWarning, Observation, calibrate_contact, default_end_time,
                                     paper_section22_calibration, paper_section22_observations, predict_table2)
 from validation.reference import solve_reference
 

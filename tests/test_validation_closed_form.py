@@ -1,11 +1,11 @@
-"""Closed-form oracles of validation.closed_form, checked against their own defining equations."""
+"""Closed-form oracles of validation.reference.closed_form, checked against their own defining equations."""
 
 import math
 
 import numpy as np
 import pytest
 
-from validation.closed_form import _g, hunt_crossley_restitution, simplified_max_displacement
+from validation.reference.closed_form import _g, hunt_crossley_restitution, simplified_max_displacement
 
 M, K, C_REC = 5600.0, 27500.0, 6239.0
 V0 = 6.86 * 564.0 / 5600.0

@@ -8,7 +8,7 @@ import pytest
 
 from mbs_models import model_i, model_ii, simplified_model
 from mbs_models.cli import main
-from validation.compare import DEFAULT_TOLERANCES, QuantityCheck, compare
+from validation.studies.compare import DEFAULT_TOLERANCES, QuantityCheck, compare
 
 PAPER_CASES = [("simplified", simplified_model, None, None)] + [
     (f"{label}-m{mass:g}-gap{gap * 1000:g}mm", factory, mass, gap)
@@ -59,7 +59,7 @@ def test_validate_cli_prints_table_and_exit_code(capsys):
 
 
 def test_validate_cli_exit_1_on_exceeded_tolerance(capsys, monkeypatch):
-    import validation.compare as compare_module
+    import validation.studies.compare as compare_module
     monkeypatch.setitem(compare_module.DEFAULT_TOLERANCES, "max_barrel_displacement", 0.0)
     assert main(["validate", "model_ii", "--end-time", "0.5", "--accuracy", "draft"]) == 1
     assert "FAILED" in capsys.readouterr().out

@@ -1,4 +1,4 @@
-"""Early stop of the reference (solve_reference(stop_when_final=...), validation.finality).
+"""Early stop of the reference (solve_reference(stop_when_final=...), validation.reference.finality).
 
 Same contract as the engine's: the metrics of an early-stopped reference are the full run's (to
 round-off: the solver's steps before the stop are the same), unproven ones are None, and the bounds
@@ -17,8 +17,8 @@ import numpy as np
 import pytest
 
 from mbs_models import Conventions, model_i, model_ii, simplified_model
-from validation import equations as eq
-from validation import finality
+from validation.reference import equations as eq
+from validation.reference import finality
 from validation.reference import solve_reference
 
 REPO = Path(__file__).resolve().parent.parent
@@ -177,7 +177,7 @@ def test_the_two_independent_implementations_agree(scene):
 
 
 def test_validation_still_imports_no_engine_code():
-    code = ("import sys, validation.reference, validation.finality\n"
+    code = ("import sys, validation.reference, validation.reference.finality\n"
             "bad = [m for m in sys.modules if m == 'exudyn' or m.startswith('exudyn.') or m in "
             "('mbs_models.simulation', 'mbs_models.final_metrics', 'mbs_models.forces', 'mbs_models.result')]\n"
             "print(bad)\nsys.exit(1 if bad else 0)\n")

@@ -1,4 +1,4 @@
-"""The paper's published numbers (validation.paper) and how the scipy reference compares with them."""
+"""The paper's published numbers (validation.studies.paper) and how the scipy reference compares with them."""
 
 import functools
 
@@ -6,7 +6,7 @@ import pytest
 
 from mbs_models import models
 from validation import PublishedValue, published_values, qualitative_claims, solve_reference, table2
-from validation.paper import MODEL_I, MODEL_II, SIMPLIFIED, TABLE2_MASSES, published
+from validation.studies.paper import MODEL_I, MODEL_II, SIMPLIFIED, TABLE2_MASSES, published
 
 
 def test_table2_has_every_cell():

@@ -267,7 +267,7 @@ def test_bad_arguments():
 
 
 def test_import_does_not_load_exudyn_or_engine():
-    code = ("import sys, validation, validation.reference, validation.closed_form, validation.paper\n"
+    code = ("import sys, validation, validation.reference, validation.reference.closed_form, validation.studies.paper\n"
             "bad = [m for m in sys.modules if m == 'exudyn' or m.startswith('exudyn.') or m in "
             "('mbs_models.simulation', 'mbs_models.assembly', 'mbs_models.forces', 'mbs_models.result', "
             "'mbs_models.peaks', 'mbs_models.accuracy', 'mbs_models.cli')]\n"
@@ -305,7 +305,7 @@ def test_rhs_is_the_equations_written_out(scene):
     """The fast scalar right-hand side equals the equations' building blocks (accelerations from
     other_forces / raw_contact_force, dissipated powers c v^2, c_r v_rel^2 and (F - k_c p^n) p') in
     every mode, bit for bit, on random states."""
-    from validation import equations as eq
+    from validation.reference import equations as eq
 
     P = eq.Parameters.from_scene(scene)
     rng = np.random.default_rng(7)
@@ -332,7 +332,7 @@ def test_rhs_is_the_equations_written_out(scene):
 def test_rhs_overflow_gives_inf_like_numpy():
     """A rejected trial step can visit absurd states: the right-hand side must give inf there (so the
     integrator shrinks the step), as numpy arithmetic does, not raise OverflowError."""
-    from validation import equations as eq
+    from validation.reference import equations as eq
 
     P = eq.Parameters.from_scene(model_ii(1.0, 0.0).with_changes(**{"contact.stiffness": 1e12}))
     mode = eq.Mode(contact=eq.ON, recoil=True, penetrated=True)

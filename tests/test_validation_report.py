@@ -9,7 +9,7 @@ from html.parser import HTMLParser
 import pytest
 
 from mbs_models.cli import main
-from validation.report import ReportOptions, write_report
+from validation.studies.report import ReportOptions, write_report
 
 
 class _Collector(HTMLParser):

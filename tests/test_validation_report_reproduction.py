@@ -7,7 +7,7 @@ import json
 import pytest
 
 from mbs_models.cli import main
-from validation.report import ReportOptions, write_report
+from validation.studies.report import ReportOptions, write_report
 
 
 @pytest.fixture(scope="module")

@@ -1,18 +1,17 @@
-"""Independent scipy implementation of the paper's Eqs. (1)-(8), closed-form oracles and published values.
+"""Validation of the engine: an independent reference implementation, and the studies that use it.
 
-Nothing here imports Exudyn or the engine modules of :mod:`mbs_models`; only the scene description
-(:mod:`mbs_models.scene`, :mod:`mbs_models.models`) is shared, so the two implementations can be compared
-point by point.  SI units throughout (m, s, kg, N, J).
+* :mod:`validation.reference` -- the scene's equations integrated with scipy, event-driven; imports
+  nothing of the engine (checked by a test);
+* :mod:`validation.studies` -- what uses both the engine and the reference: comparisons, the guarantee
+  tolerances, the replication report, the convention study, the contact-law calibration, the
+  work-precision study, and the paper's published numbers.
 
-* :func:`solve_reference` -- event-driven ``solve_ivp`` solution -> :class:`ReferenceResult`;
-* :func:`simplified_max_displacement`, :func:`hunt_crossley_restitution` -- closed-form oracles;
-* :func:`table2`, :func:`published_values`, :func:`qualitative_claims` -- what the paper publishes.
+Importing this package loads neither Exudyn nor the engine.
 """
 
-from .closed_form import hunt_crossley_restitution, simplified_max_displacement
-from .paper import PublishedValue, QualitativeClaim, published_values, qualitative_claims, table2
-from .reference import METHODS, ReferenceSolveError, solve_reference
-from .result import ReferenceImpact, ReferenceResult, ReferenceSegment
+from .reference import (METHODS, ReferenceImpact, ReferenceResult, ReferenceSegment, ReferenceSolveError,
+                        hunt_crossley_restitution, simplified_max_displacement, solve_reference)
+from .studies.paper import PublishedValue, QualitativeClaim, published_values, qualitative_claims, table2
 
 __all__ = [
     "solve_reference", "ReferenceResult", "ReferenceImpact", "ReferenceSegment", "ReferenceSolveError",

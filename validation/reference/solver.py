@@ -1,6 +1,6 @@
 """Event-driven scipy reference solution of the paper's Eqs. (1)-(8).
 
-:func:`solve_reference` integrates the equations of :mod:`validation.equations` with
+:func:`solve_reference` integrates the equations of :mod:`validation.reference.equations` with
 ``scipy.integrate.solve_ivp`` in segments on which the right-hand side is smooth.  A segment stops at
 every switch (terminal events, located by root finding on the dense output):
 
@@ -8,12 +8,12 @@ every switch (terminal events, located by root finding on the dense output):
 * ``s``  -- Hunt-Crossley force reaching 0 by clipping, ``1 + lambda p' = 0`` while ``p > 0``;
 * ``pd`` -- ``p' = 0`` while ``p > 0`` (only with the ``compression_only`` convention);
 * ``v``  -- barrel velocity sign change, switch of the recoil damper, Eqs. (2)-(3);
-* ``release`` / ``slip`` -- end of a STICK (sliding) phase, see :mod:`validation.equations`.
+* ``release`` / ``slip`` -- end of a STICK (sliding) phase, see :mod:`validation.reference.equations`.
 
 At each restart the mode is chosen from the state; a quantity sitting on its switching surface is
 classified by the direction the state is heading (the crossing direction of the event that stopped the
 previous segment, or the sign of its time derivatives).  Metrics are refined on the dense output
-(root finding on the derivative), not taken from samples; see :mod:`validation.result`.
+(root finding on the derivative), not taken from samples; see :mod:`validation.reference.result`.
 """
 
 from __future__ import annotations
@@ -217,8 +217,8 @@ def solve_reference(scene: Scene, end_time: float = 10.0, *, method: str = "DOP8
     impact_threshold: contact episodes with a peak force above this (N) are reported as impacts.
     max_step: largest solver step in s (keeps grazing contacts from being stepped over).
     max_segments: cap on the number of smooth segments; more raises :class:`ReferenceSolveError`.
-    stop_when_final: metric names among :data:`validation.finality.METRICS`; the integration stops
-        once energy bounds (:mod:`validation.finality`) prove that none of them can change before
+    stop_when_final: metric names among :data:`validation.reference.finality.METRICS`; the integration stops
+        once energy bounds (:mod:`validation.reference.finality`) prove that none of them can change before
         ``end_time``: checked at every segment end, and inside a segment by a terminal event (which
         leaves the solver's steps before it unchanged, so the window is the full run's prefix).  The
         result then covers ``[0, result.end_time]``, ``result.stop_reason == "metrics_final"``, and

@@ -180,7 +180,7 @@ class Observation:
 # ------------------------------------------------------------------------------------- forward models
 def reference_forward(rtol: float = 1e-8, atol: float = 1e-11, method: str = "DOP853", **options) -> Callable:
     """Forward model ``simulate(scene, end_time)`` using the scipy reference with the given tolerances."""
-    from .reference import solve_reference
+    from ..reference import solve_reference
 
     def simulate(scene: Scene, end_time: float):
         return solve_reference(scene, end_time, method=method, rtol=rtol, atol=atol, **options)
@@ -719,7 +719,7 @@ def predict_table2(contact: Contact | CalibrationResult, *, conventions: Convent
 
     ``contact`` is a :class:`Contact` or a :class:`CalibrationResult`; its k_c, n_c, lambda are used (the gap
     is 0 as in Table 2).  The forward model defaults to the scipy reference at its default (tight)
-    tolerances, stopped once the maximum is proven final (the full run's value; validation.finality).  Returns one row per (model, absorber mass): ``model``, ``absorber_mass`` (kg),
+    tolerances, stopped once the maximum is proven final (the full run's value; validation.reference.finality).  Returns one row per (model, absorber mass): ``model``, ``absorber_mass`` (kg),
     ``max_barrel_displacement`` (m), ``published`` (m), ``relative_error``.
     """
     if isinstance(contact, CalibrationResult):
@@ -727,7 +727,7 @@ def predict_table2(contact: Contact | CalibrationResult, *, conventions: Convent
     if not isinstance(contact, Contact):
         raise SceneError("contact", f"must be a Contact or a CalibrationResult, got {type(contact).__name__}")
     if solver is None:
-        from .reference import solve_reference
+        from ..reference import solve_reference
 
         def simulate(scene: Scene, end_time: float):  # only the maximum is read: stop once it is final
             return solve_reference(scene, end_time, stop_when_final=("max_barrel_displacement",))

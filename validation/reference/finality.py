@@ -1,16 +1,16 @@
 """Energy bounds that tell the reference solver when a peak metric can no longer change.
 
-Written from the equations of :mod:`validation.equations`, independently of the engine's
+Written from the equations of :mod:`validation.reference.equations`, independently of the engine's
 ``mbs_models.final_metrics`` (the two implementations are compared by the tests).
 
 For a dissipative scene the mechanical energy
 ``E = kinetic + recoil spring + absorber spring + contact elastic`` (J, see
-:func:`validation.equations.energy_components`) never increases: its rate is minus the dissipated
-power of :func:`validation.equations.rhs`, which is >= 0 for the recoil damper (``c v_M^2``), the
+:func:`validation.reference.equations.energy_components`) never increases: its rate is minus the dissipated
+power of :func:`validation.reference.equations.rhs`, which is >= 0 for the recoil damper (``c v_M^2``), the
 absorber damper (``c_r v_rel^2``) and the contact (``(F - k_c p^n) p'``: ``lambda k_c p^n p'^2``
 unclipped, ``-k_c p^n p' > 0`` clipped at ``p' < -1/lambda``; with ``compression_only`` the force is
 ``k_c p^n s`` or 0 for ``p' <= 0``, and in the sliding mode ``p' = 0``).  Only ``literal_lambda_sign``
-(``lambda < 0`` in :class:`~validation.equations.Parameters`) injects energy: no bound then.
+(``lambda < 0`` in :class:`~validation.reference.equations.Parameters`) injects energy: no bound then.
 
 Each energy term is at most E, so at every later time (values in SI units):
 
@@ -37,7 +37,7 @@ import numpy as np
 from . import equations as eq
 from .equations import Parameters
 
-#: The metrics that can be proven final (names of :class:`~validation.result.ReferenceResult` properties).
+#: The metrics that can be proven final (names of :class:`~validation.reference.result.ReferenceResult` properties).
 METRICS = ("max_barrel_displacement", "peak_contact_force", "max_absorber_velocity", "impacts")
 #: Relative margin on the energy in every bound.
 ENERGY_SLACK = 1e-4

@@ -1,4 +1,4 @@
-"""Checking the paper's qualitative claims (:func:`validation.paper.qualitative_claims`) on our results.
+"""Checking the paper's qualitative claims (:func:`validation.studies.paper.qualitative_claims`) on our results.
 
 Each claim's ``predicate`` text is implemented here as code over a :class:`ClaimEvidence` (engine
 results for m = 1000 kg at gap 0, Table 2 values and the gap sweeps), so the report can say which

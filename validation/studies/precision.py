@@ -68,7 +68,7 @@ from mbs_models.models import model_i, model_ii, simplified_model
 from mbs_models.peaks import runs_of_true
 from mbs_models.scene import Scene
 
-from .equations import Parameters
+from ..reference.equations import Parameters
 
 #: Metrics of the study, in the order of the tables and figures.
 METRICS = ("max_barrel_displacement", "peak_contact_force", "max_absorber_velocity", "barrel_trajectory_l2")
@@ -234,7 +234,7 @@ def trajectory_grid(end_time: float) -> np.ndarray:
 def compute_truth(scene: Scene, end_time: float = 10.0, *, rtol: float = TRUTH_RTOL, atol: float = TRUTH_ATOL,
                   check_rtol: float | None = CHECK_RTOL, impact_threshold: float = 1000.0) -> Truth:
     """The event-driven reference at ``rtol``; with ``check_rtol`` also its uncertainty (see :class:`Truth`)."""
-    from .reference import solve_reference
+    from ..reference import solve_reference
 
     start = time.perf_counter()
     reference = solve_reference(scene, end_time, rtol=rtol, atol=atol, impact_threshold=impact_threshold)
@@ -333,7 +333,7 @@ def impact_mismatch(values: RunValues, truth: Truth) -> tuple[int, int]:
 def plain_rhs(P: Parameters) -> Callable[[float, np.ndarray], list[float]]:
     """Right-hand side ``f(t, y)``, ``y = [x_M, v_M, x_m, v_m]``, of Eqs. (1)-(8) as the engine integrates
     them: damper coefficient from the sign of the barrel velocity, Hunt-Crossley force
-    ``k_c max(p, 0)^n (1 + lambda p')`` clipped to >= 0 (the same laws as :mod:`validation.equations`,
+    ``k_c max(p, 0)^n (1 + lambda p')`` clipped to >= 0 (the same laws as :mod:`validation.reference.equations`,
     written with plain floats for speed)."""
     M, k, c_rec, c_cnt = P.M, P.k, P.c_recoil, P.c_counter
     if not P.has_absorber:

@@ -17,8 +17,8 @@ from mbs_models.peaks import HermiteTrajectory
 from mbs_models.result import Result
 from mbs_models.scene import Scene
 
-from .reference import solve_reference
-from .result import ReferenceResult
+from ..reference import solve_reference
+from ..reference import ReferenceResult
 
 #: Relative tolerances of the metrics at the ``standard`` preset (validation issue).
 DEFAULT_TOLERANCES = {
