@@ -16,9 +16,9 @@ from __future__ import annotations
 import importlib
 
 from .errors import RecoilError, SceneError, SimulationError
-from .models import model_i, model_ii, paper_model, simplified_model
-from .scene import Absorber, Barrel, Contact, Conventions, Firing, RecoilDamper, RecoilSpring, Scene
-from .scene_io import load_scene, scene_from_dict, scene_to_dict, scene_to_toml
+from .scene import (Absorber, Barrel, BatteryStop, Contact, Conventions, Firing, RecoilDamper, RecoilSpring, RecoilStop,
+                    Scene, load_scene, model_i, model_ii, paper_model, scene_from_dict, scene_to_dict, scene_to_toml,
+                    simplified_model)
 
 __version__ = "0.1.0"
 
@@ -37,7 +37,8 @@ _LAZY = {
 }
 
 __all__ = [
-    "Absorber", "Barrel", "Contact", "Conventions", "Firing", "RecoilDamper", "RecoilSpring", "Scene",
+    "Absorber", "Barrel", "BatteryStop", "Contact", "Conventions", "Firing", "RecoilDamper", "RecoilSpring",
+    "RecoilStop", "Scene",
     "RecoilError", "SceneError", "SimulationError",
     "load_scene", "scene_from_dict", "scene_to_dict", "scene_to_toml",
     "model_i", "model_ii", "paper_model", "simplified_model",

@@ -7,12 +7,14 @@ import math
 
 import pytest
 
-from mbs_models import model_ii, scene_to_dict
+import tomllib
+
+from mbs_models.scenes import scene_path
 
 
 def paper_scene_dict() -> dict:
-    """Model (ii), m = 1000 kg, gap 0, as a TOML mapping."""
-    return scene_to_dict(model_ii(1000.0, 0.0))
+    """Model (ii), m = 1000 kg, gap 0: the shipped version-1 file as a TOML mapping."""
+    return tomllib.loads(scene_path("model_ii").read_text())
 
 
 def _edit(path: str, value):
@@ -62,10 +64,11 @@ BAD_SCENES = [
     ("absorber-without-contact", _delete("contact"), "contact", "needs a [contact]"),
     ("contact-without-absorber", _delete("absorber"), "absorber", "needs an [absorber]"),
     ("unknown-mount", _edit("absorber.mount", "roof"), "absorber.mount", "unknown mount"),
-    ("unknown-law", _edit("contact.law", "hertz"), "contact.law", "unknown law"),
+    ("unknown-law", _edit("contact.law", "hertzian"), "contact.law", "unknown law"),
+    ("law-of-version-2", _edit("contact.law", "hertz"), "contact.law", "version-2 scene"),
     ("zero-projectile-mass", _edit("firing.projectile_mass", 0.0), "firing.projectile_mass", "> 0"),
     ("both-velocities", _edit("barrel.initial_velocity", 0.7), "barrel.initial_velocity", "not both"),
-    ("bad-version", _edit("version", 2), "version", "unsupported"),
+    ("bad-version", _edit("version", 3), "version", "unsupported"),
     ("bad-convention", _edit("conventions", {"literal_lambda_sign": "yes"}), "conventions.literal_lambda_sign",
      "true or false"),
 ]

@@ -1,4 +1,4 @@
-"""Scene validation through the Python API (mbs_models.scene, mbs_models.scene_io)."""
+"""Scene validation through the Python API (mbs_models.scene, mbs_models.scene.io)."""
 
 from __future__ import annotations
 

@@ -10,7 +10,7 @@ from dataclasses import replace
 import pytest
 
 from mbs_models import SceneError, model_i, model_ii
-from mbs_models.models import PAPER_CONTACT_DAMPING_FACTOR, PAPER_CONTACT_EXPONENT, PAPER_CONTACT_STIFFNESS
+from mbs_models.scene.models import PAPER_CONTACT_DAMPING_FACTOR, PAPER_CONTACT_EXPONENT, PAPER_CONTACT_STIFFNESS
 from validation.studies.calibration import (CalibrationWarning, Observation, calibrate_contact, default_end_time,
                                     paper_section22_calibration, paper_section22_observations, predict_table2)
 from validation.reference import solve_reference

@@ -4,7 +4,7 @@ import functools
 
 import pytest
 
-from mbs_models import models
+from mbs_models.scene import models
 from validation import PublishedValue, published_values, qualitative_claims, solve_reference, table2
 from validation.studies.paper import MODEL_I, MODEL_II, SIMPLIFIED, TABLE2_MASSES, published
 

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from mbs_models.models import model_i, model_ii, simplified_model
+from mbs_models.scene.models import model_i, model_ii, simplified_model
 from mbs_models.scene import Absorber, Barrel, Contact, Conventions, RecoilDamper, RecoilSpring, Scene
 from validation import (ReferenceSolveError, hunt_crossley_restitution, simplified_max_displacement,
                         solve_reference)

@@ -37,7 +37,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from mbs_models.errors import SceneError, SimulationError
-from mbs_models.models import model_i, model_ii
+from mbs_models.scene.models import model_i, model_ii
 from mbs_models.scene import Contact, Conventions, Scene
 
 from . import paper

@@ -64,7 +64,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import minimize_scalar
 
-from mbs_models.models import model_i, model_ii, simplified_model
+from mbs_models.scene.models import model_i, model_ii, simplified_model
 from mbs_models.peaks import runs_of_true
 from mbs_models.scene import Scene
 

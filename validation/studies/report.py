@@ -27,7 +27,7 @@ from typing import Callable
 import numpy as np
 
 from mbs_models import model_i, model_ii, simplified_model, simulate
-from mbs_models.models import model_i as _model_i_doc, model_ii as _model_ii_doc, simplified_model as _simp_doc
+from mbs_models.scene.models import model_i as _model_i_doc, model_ii as _model_ii_doc, simplified_model as _simp_doc
 from mbs_models.outputs import atomic_write_json, atomic_write_text, prepare_output_dir
 from mbs_models.plotting import (MODEL_COLOURS, figure_png, new_figure, plot_barrel_displacements,
                                  plot_contact_histories, plot_first_impact)

@@ -7,7 +7,13 @@ The shipped TOML files in ``mbs_models/scenes/`` hold the same values for m = 10
 
 from __future__ import annotations
 
-from .scene import Absorber, Barrel, Contact, Conventions, Firing, RecoilDamper, RecoilSpring, Scene
+from ..elements.absorber import Absorber
+from ..elements.barrel import Barrel
+from ..elements.contact_laws import Contact
+from ..elements.firing import Firing
+from ..elements.recoil_damper import RecoilDamper
+from ..elements.recoil_spring import RecoilSpring
+from .container import Conventions, Scene
 
 #: Barrel mass M, kg (Section 2.1).
 PAPER_BARREL_MASS = 5600.0
@@ -107,5 +113,5 @@ def paper_model(model: str, absorber_mass: float = 1000.0, gap: float = 0.0,
         return model_i(absorber_mass, gap, conventions)
     if key == "ii":
         return model_ii(absorber_mass, gap, conventions)
-    from .errors import SceneError
+    from ..errors import SceneError
     raise SceneError("model", f"unknown model {model!r}; allowed: 'simplified', 'i', 'ii'")

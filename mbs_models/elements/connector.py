@@ -1,0 +1,171 @@
+"""Bodies and connectors: what every element is made of, and what the engine iterates over.
+
+A recoil mechanism here is one-dimensional: every :class:`Body` moves along the recoil axis
+(position positive in the recoil direction, 0 at the start), and every force acts between two points
+of that axis -- two bodies, or a body and the ground (:data:`GROUND`).  Such a force is a
+:class:`Connector` between point ``a`` and point ``b``::
+
+    d  = x_b - x_a        relative coordinate (m)        d' = v_b - v_a  its rate (m/s)
+    F  = force(d, d')     N, positive: pushes b towards -x and a towards +x (a stretched spring, a
+                          compressed contact whose penetration grows with d)
+
+exactly as Exudyn's ``ObjectConnectorCoordinateSpringDamper`` with markers ``[a, b]`` applies its
+force.  From these two definitions everything generic follows and is written once:
+
+* the force on the ground, positive in the recoil direction: ``+F`` if ``a`` is the ground, ``-F`` if
+  ``b`` is (:attr:`Connector.support_sign`); the support force is their sum;
+* stored energy ``U(d)`` and dissipated power; their integrals close the energy balance per connector;
+* the linear stiffness of springs (the quadratic form behind the energy bounds of the early stop) and
+  the force bounds of each connector given bounds on ``d`` and ``d'``.
+
+Element modules subclass :class:`Connector` where they need a law of their own (the asymmetric recoil
+damper, the contact laws) and keep Exudyn's built-in linear spring-damper otherwise.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from .ops import NUMPY_OPS, Ops, make_user_function, ops_for
+
+#: The name of the ground as a connector end.
+GROUND = "ground"
+
+
+@dataclass(frozen=True)
+class Body:
+    """A mass on the recoil axis: ``name``, ``mass`` (kg), ``initial_velocity`` (m/s); it starts at x = 0."""
+
+    name: str
+    mass: float
+    initial_velocity: float = 0.0
+    element: str = ""
+
+
+#: ``quadrature(power_at_nodes) -> cumulative energy`` over the output samples (J): see
+#: :func:`mbs_models.results.postprocess.cumulative_quadrature`.
+Quadrature = Callable[[np.ndarray], np.ndarray]
+
+
+class Connector:
+    """A force between points ``a`` and ``b`` of the recoil axis (see the module docstring).
+
+    The base class is Exudyn's linear spring-damper ``F = stiffness d + damping d'`` (either may be 0),
+    which needs no user function.  Subclasses with a law of their own set :attr:`needs_user_function`
+    and implement :meth:`law`.
+
+    Attributes
+    ----------
+    name: unique id in the scene: the key of its energies and outputs (``"recoil_spring"``, ``"contact"``).
+    element: the name of the scene element it belongs to (the per-element energy table groups by it).
+    a, b: body names (or :data:`GROUND`) at the connector's two markers.
+    stiffness: linear stiffness in N/m (0: none).
+    damping: linear damping in N s/m (0: none).
+    records_force: a sensor records the force at every step (contacts: their force is an output).
+    """
+
+    needs_user_function = False
+    records_force = False
+    is_contact = False
+
+    def __init__(self, name: str, element: str, a: str, b: str, *, stiffness: float = 0.0, damping: float = 0.0):
+        if a == b:
+            raise ValueError(f"connector {name!r} joins {a!r} to itself")
+        self.name, self.element, self.a, self.b = name, element, a, b
+        self.stiffness, self.damping = float(stiffness), float(damping)
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}({self.name!r}, {self.a} -> {self.b})"
+
+    # ------------------------------------------------------------------ geometry
+    @property
+    def support_sign(self) -> float:
+        """+1 if ``a`` is the ground, -1 if ``b`` is, 0 for a connector between two bodies."""
+        return 1.0 if self.a == GROUND else (-1.0 if self.b == GROUND else 0.0)
+
+    # ------------------------------------------------------------------ the law
+    def law(self, d, rate, ops: Ops):
+        """The force in N at relative coordinate ``d`` (m) and rate ``rate`` (m/s), over ``ops``."""
+        return self.stiffness * d + self.damping * rate
+
+    def user_function_law(self, ops: Ops) -> Callable:
+        """``f(d, rate)`` to record as Exudyn's spring-force user function (see :meth:`law`)."""
+        return lambda d, rate: self.law(d, rate, ops)
+
+    def force(self, d, rate, t=None):
+        """The force (N) on arrays of ``d`` (m), ``rate`` (m/s) at times ``t`` (s): numpy backend."""
+        return self.law(d, rate, NUMPY_OPS)
+
+    # ------------------------------------------------------------------ Exudyn
+    def add_items(self, mbs, marker_a, marker_b, user_functions: str = "symbolic"):
+        """Add the connector to an Exudyn system between two coordinate markers; return its ObjectIndex.
+
+        An ``ObjectConnectorCoordinateSpringDamper`` with markers ``[marker_a, marker_b]``: Exudyn's
+        built-in linear law, or :meth:`user_function_law` as its spring-force user function
+        (``user_functions``: ``"symbolic"`` -- recorded once, evaluated in C++ -- or ``"python"``).  The
+        connector keeps the user function alive (:attr:`index` is the item).
+        """
+        from exudyn.itemInterface import ObjectConnectorCoordinateSpringDamper
+
+        index = mbs.AddObject(ObjectConnectorCoordinateSpringDamper(
+            markerNumbers=[marker_a, marker_b], stiffness=self.stiffness, damping=self.damping,
+            visualization={"show": False, "drawSize": -1.0, "color": [-1.0, -1.0, -1.0, -1.0]}))
+        if self.needs_user_function:
+            law = self.user_function_law(ops_for(user_functions))
+
+            def user_function(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
+                return law(displacement, velocity)
+
+            self._user_function = make_user_function(mbs, user_function, user_functions, index)
+            mbs.SetObjectParameter(index, "springForceUserFunction", self._user_function)
+        self.index = index
+        return index
+
+    # ------------------------------------------------------------------ energy
+    @property
+    def stores_energy(self) -> bool:
+        """True if the connector has a potential (a spring, a contact)."""
+        return self.stiffness > 0
+
+    @property
+    def dissipates(self) -> bool:
+        """True if the connector dissipates energy (a damper, a damped contact)."""
+        return self.damping > 0
+
+    def stored_energy(self, d):
+        """Stored (potential) energy in J at ``d`` (m): ``stiffness d^2 / 2``."""
+        return 0.5 * self.stiffness * np.asarray(d, dtype=float) ** 2
+
+    def dissipated_energy(self, quadrature: Quadrature, d_nodes, rate_nodes, times_nodes, stored):
+        """Cumulative dissipated energy (J) at the output samples: ``damping d'^2`` integrated.
+
+        ``d_nodes``, ``rate_nodes`` and ``times_nodes`` are values at each output interval's quadrature
+        nodes (shape (intervals, nodes)); ``stored`` is :meth:`stored_energy` at the output samples.
+        """
+        return quadrature(self.damping * rate_nodes ** 2)
+
+    # ------------------------------------------------------------------ bounds
+    @property
+    def linear_damping(self) -> float:
+        """Damping (N s/m) of the linearised connector (stability checks)."""
+        return self.damping
+
+    @property
+    def linear_stiffness(self) -> float:
+        """Stiffness (N/m) of the connector's linear, always-acting spring: its energy ``k d^2 / 2``
+        enters the quadratic form of the energy bounds."""
+        return self.stiffness
+
+    def force_bound(self, d_bound: float, rate_bound: float, energy: float) -> float:
+        """Bound (N) on |F| when |d| <= ``d_bound`` (m) and |d'| <= ``rate_bound`` (m/s) and the
+        mechanical energy is ``energy`` (J) at most."""
+        bound = 0.0
+        if self.stiffness > 0:
+            bound += self.stiffness * d_bound
+        if self.damping > 0:
+            bound += self.damping * rate_bound
+        return bound if math.isfinite(bound) else math.inf

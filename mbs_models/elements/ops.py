@@ -1,0 +1,76 @@
+"""The few operations a force law needs, for each backend: a law is written once and run by three.
+
+* ``PYTHON_OPS`` -- plain floats, used by Exudyn's Python user functions (what people debug with);
+* symbolic (:func:`symbolic_ops`) -- :mod:`exudyn.symbolic` expressions, recorded once and evaluated
+  in C++ (the default backend of the engine);
+* ``NUMPY_OPS`` -- arrays, used in post-processing (peak refinement, energies, the support force).
+
+Because every backend runs the *same* law function, they cannot drift apart; a test checks that the
+Python and symbolic user functions give the same simulation to 1e-9.  Element modules write their laws
+over these ops (see :mod:`mbs_models.elements.recoil_damper` and :mod:`mbs_models.elements.contact_laws`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Callable
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Ops:
+    """The operations of one backend.
+
+    ``maximum(a, b)``, ``power(a, x)``, ``choose(condition, value_if_true, value_if_false)`` (values are
+    numbers), ``name``: ``"python"``, ``"symbolic"`` or ``"numpy"``.
+    """
+
+    maximum: Callable[[Any, Any], Any]
+    power: Callable[[Any, float], Any]
+    choose: Callable[[Any, float, float], Any]
+    name: str = "python"
+
+
+def _py_choose(condition, a, b):
+    return a if condition else b
+
+
+PYTHON_OPS = Ops(maximum=max, power=math.pow, choose=_py_choose, name="python")
+NUMPY_OPS = Ops(maximum=np.maximum, power=np.power, choose=np.where, name="numpy")
+
+
+def symbolic_ops() -> Ops:
+    """The :mod:`exudyn.symbolic` backend (imports Exudyn)."""
+    import exudyn
+
+    esym = exudyn.symbolic
+
+    def choose(condition, a, b):
+        return esym.IfThenElse(condition, esym.Real(a), esym.Real(b))
+
+    return Ops(maximum=esym.max, power=esym.pow, choose=choose, name="symbolic")
+
+
+def ops_for(backend: str) -> Ops:
+    """The ops of a user-function backend: ``"symbolic"`` or ``"python"``."""
+    if backend == "symbolic":
+        return symbolic_ops()
+    if backend == "python":
+        return PYTHON_OPS
+    raise ValueError(f"user_functions must be 'symbolic' or 'python', got {backend!r}")
+
+
+def make_user_function(mbs, python_function, backend: str, item_index):
+    """What to pass as a connector's ``springForceUserFunction``: the Python callable, or its symbolic record.
+
+    ``python_function(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset)`` is the
+    signature of ``ObjectConnectorCoordinateSpringDamper.springForceUserFunction``; ``backend`` is
+    ``"python"`` or ``"symbolic"``.  The symbolic object must be kept alive as long as the system exists.
+    """
+    if backend == "python":
+        return python_function
+    from exudyn.advancedUtilities import CreateSymbolicUserFunction
+
+    return CreateSymbolicUserFunction(mbs, python_function, "springForceUserFunction", item_index)

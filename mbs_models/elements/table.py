@@ -1,0 +1,174 @@
+"""The base of every scene table: a frozen dataclass that validates itself on construction.
+
+An element module defines its table as a subclass of :class:`Table`::
+
+    @dataclass(frozen=True)
+    class RecoilSpring(Table):
+        stiffness: float
+        TABLE: ClassVar[str] = "recoil_spring"          # the TOML table, and the Scene attribute
+        ORDER: ClassVar[int] = 20                        # position in the assembly order
+        RULES: ClassVar = {"stiffness": Rule(0.0, unit="N/m")}
+
+and nothing else registers it: :mod:`mbs_models.elements` finds every Table subclass of its modules.
+A table built in Python is checked exactly like one read from TOML; every error is a
+:class:`~mbs_models.errors.SceneError` naming the key (``recoil_spring.stiffness``) and the allowed range.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+from dataclasses import dataclass, fields
+from typing import Any, ClassVar, Iterable
+
+from ..errors import SceneError
+
+
+@dataclass(frozen=True)
+class Rule:
+    """Allowed values of a numeric field: ``value >= minimum`` (``> minimum`` if ``strict``), ``<= maximum``
+    (``< maximum`` if ``strict_maximum``); ``unit`` is named in messages.  ``None`` bounds are open."""
+
+    minimum: float | None = None
+    strict: bool = False
+    unit: str = ""
+    maximum: float | None = None
+    strict_maximum: bool = False
+
+    def describe(self) -> str:
+        """The allowed range in words, e.g. ``> 0 kg`` or ``in (0, 1]``."""
+        suffix = f" {self.unit}" if self.unit else ""
+        if self.minimum is not None and self.maximum is not None:
+            left = "(" if self.strict else "["
+            right = ")" if self.strict_maximum else "]"
+            return f"in {left}{self.minimum:g}, {self.maximum:g}{right}{suffix}"
+        if self.minimum is not None:
+            return f"{'>' if self.strict else '>='} {self.minimum:g}{suffix}"
+        if self.maximum is not None:
+            return f"{'<' if self.strict_maximum else '<='} {self.maximum:g}{suffix}"
+        return f"a finite number{suffix}"
+
+
+def check_number(key: str, value, rule: Rule = Rule()) -> float:
+    """Return ``value`` as float, or raise SceneError naming ``key`` and the allowed range."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise SceneError(key, f"must be a number, got {type(value).__name__} {value!r}")
+    value = float(value)
+    if not math.isfinite(value):
+        raise SceneError(key, f"must be a finite number, got {value}")
+    too_small = rule.minimum is not None and (value <= rule.minimum if rule.strict else value < rule.minimum)
+    too_large = rule.maximum is not None and (value >= rule.maximum if rule.strict_maximum else value > rule.maximum)
+    if too_small or too_large:
+        if rule.minimum is not None and rule.maximum is None:
+            # the wording of version 1 ("must be > 0 kg, got -5")
+            raise SceneError(key, f"must be {rule.describe()}, got {value:g}")
+        raise SceneError(key, f"must be {rule.describe()}, got {value:g}")
+    return value
+
+
+def check_choice(key: str, value, allowed: Iterable[str], what: str = "value") -> str:
+    """Return ``value`` if it is one of ``allowed`` strings, else a SceneError with a "did you mean"."""
+    allowed = tuple(allowed)
+    if not isinstance(value, str):
+        raise SceneError(key, f"must be a string, one of {', '.join(allowed)}")
+    if value not in allowed:
+        raise SceneError(key, f"unknown {what} {value!r}{suggestion(value, allowed)}")
+    return value
+
+
+def suggestion(word: str, allowed: Iterable[str]) -> str:
+    """``"; did you mean 'x'?"`` for the closest allowed word, else ``"; allowed: a, b, c"``."""
+    allowed = sorted(allowed)
+    close = difflib.get_close_matches(word, allowed, n=1, cutoff=0.6)
+    if close:
+        return f"; did you mean {close[0]!r}?"
+    return f"; allowed: {', '.join(allowed)}"
+
+
+def rekey(error: SceneError, old_prefix: str, new_prefix: str) -> SceneError:
+    """The same error with its key's ``old_prefix`` replaced (a nested or indexed table names its place)."""
+    key = error.key
+    if key == old_prefix or key.startswith(old_prefix + "."):
+        key = new_prefix + key[len(old_prefix):]
+    elif not key:
+        key = new_prefix
+    return SceneError(key, error.message)
+
+
+class Table:
+    """Mixin of every scene table (a frozen dataclass): class attributes describe it, ``RULES`` check it.
+
+    Class attributes
+    ----------------
+    TABLE: the TOML table name and the :class:`~mbs_models.scene.Scene` attribute (``"recoil_spring"``).
+    MANY: True for an array of tables (``[[absorber]]``): the scene holds a tuple, attribute ``TABLE + "s"``.
+    ORDER: position in the scene's element order (assembly, energy sums, outputs); smaller first.
+    SINCE_VERSION: the first scene-format version that has this table (2 for the new effects).
+    RULES: field name -> :class:`Rule` for numeric fields (``None`` values are skipped: optional fields).
+    REQUIRED: keys a file must give (default: the fields without a default value).
+    NESTED: field name -> Table class of a sub-table (``[absorber.contact]``).
+    """
+
+    TABLE: ClassVar[str] = ""
+    MANY: ClassVar[bool] = False
+    ORDER: ClassVar[int] = 100
+    SINCE_VERSION: ClassVar[int] = 1
+    RULES: ClassVar[dict[str, Rule]] = {}
+    NESTED: ClassVar[dict[str, type]] = {}
+
+    def __post_init__(self):
+        for name, rule in self.RULES.items():
+            value = getattr(self, name)
+            if value is not None:
+                object.__setattr__(self, name, check_number(f"{self.TABLE}.{name}", value, rule))
+        for name, cls in self.NESTED.items():
+            value = getattr(self, name)
+            if value is not None and not isinstance(value, cls):
+                raise SceneError(f"{self.TABLE}.{name}", f"must be a {cls.__name__} table, got {type(value).__name__}")
+
+    # ------------------------------------------------------------------ description
+    @classmethod
+    def field_names(cls) -> list[str]:
+        """The table's keys (dataclass fields), in order."""
+        return [f.name for f in fields(cls)]
+
+    @classmethod
+    def required_keys(cls) -> tuple[str, ...]:
+        """Keys a file must give: the fields without a default."""
+        from dataclasses import MISSING
+        return tuple(f.name for f in fields(cls) if f.default is MISSING and f.default_factory is MISSING)
+
+    @classmethod
+    def from_mapping(cls, data: dict[str, Any], key: str, version: int) -> "Table":
+        """Build the table from a parsed TOML mapping; errors name ``key`` (the table's place in the file)."""
+        if not isinstance(data, dict):
+            raise SceneError(key, f"must be a table [{key}], got {type(data).__name__}")
+        names = cls.field_names()
+        for name in data:
+            if name not in names:
+                raise SceneError(f"{key}.{name}", f"unknown key{suggestion(name, names)}")
+        for name in cls.required_keys():
+            if name not in data:
+                raise SceneError(f"{key}.{name}", "missing required key")
+        values = dict(data)
+        for name, nested in cls.NESTED.items():
+            if name in values:
+                values[name] = nested.from_mapping(values[name], f"{key}.{name}", version)
+        try:
+            return cls(**values)
+        except SceneError as exc:
+            raise rekey(exc, cls.TABLE, key) from None
+
+    def to_mapping(self) -> dict[str, Any]:
+        """The TOML mapping of this table (inverse of :meth:`from_mapping`); omits fields that are None."""
+        out: dict[str, Any] = {}
+        for name in self.field_names():
+            value = getattr(self, name)
+            if value is None:
+                continue
+            out[name] = value.to_mapping() if isinstance(value, Table) else value
+        return out
+
+    def check_in_scene(self, scene, key: str) -> None:
+        """Checks that need the whole scene (e.g. a stop's position against the other stop); ``key`` is
+        this table's place in the scene (``"absorber.1"``).  Default: none."""

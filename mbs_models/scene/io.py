@@ -1,0 +1,197 @@
+"""Reading and writing scenes: TOML versions 1 and 2.
+
+``load_scene(path)`` is the one entry point for files; :func:`scene_from_dict` checks keys (unknown keys
+with a "did you mean", missing keys, wrong table types, tables a version does not have) before the
+element tables check their values.  Every problem is a :class:`~mbs_models.errors.SceneError` naming
+the key as it stands in the file (``contact.gap``, ``absorber.1.contact.restitution``).
+
+* **Version 1** (no ``version`` key, or ``version = 1``): the paper's scenes -- ``[barrel]``,
+  ``[firing]``, ``[recoil_spring]``, ``[recoil_damper]`` (the last two required), at most one
+  ``[absorber]`` with its ``[contact]`` (Hunt-Crossley), ``[conventions]``.  It keeps loading unchanged.
+* **Version 2** (``version = 2``): every element table of :mod:`mbs_models.elements` is optional but
+  ``[barrel]``; absorbers are ``[[absorber]]`` with ``[absorber.contact]`` (a version-1 ``[absorber]`` +
+  ``[contact]`` pair is read as one); ``[recoil_stop]``, ``[battery_stop]``; every contact law.
+
+:func:`scene_to_toml` writes version 2.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+from ..elements import ELEMENT_TABLES
+from ..elements.contact_laws import Contact
+from ..elements.table import suggestion
+from ..errors import SceneError
+from .container import Conventions, Scene
+
+#: The scene format versions this library reads; it writes the last.
+FORMAT_VERSIONS = (1, 2)
+FORMAT_VERSION = FORMAT_VERSIONS[-1]
+#: Tables a version-1 file must have.
+_REQUIRED_V1 = ("barrel", "recoil_spring", "recoil_damper")
+_TOP_LEVEL_SCALARS = ("name", "version")
+
+
+def _version(data: dict) -> int:
+    version = data.get("version", 1)
+    if isinstance(version, bool) or version not in FORMAT_VERSIONS:
+        raise SceneError("version", f"unsupported scene format version {version!r}; this library reads "
+                                    f"{' and '.join(str(v) for v in FORMAT_VERSIONS)}")
+    return int(version)
+
+
+def _absorber_entries(data: dict, version: int) -> list[tuple[str, Any]]:
+    """``(key, mapping)`` of every absorber in the file: ``[absorber]`` (one) or ``[[absorber]]``."""
+    content = data.get("absorber")
+    if content is None:
+        return []
+    if isinstance(content, dict):
+        return [("absorber", content)]
+    if isinstance(content, list) and version >= 2:
+        if len(content) == 1:
+            return [("absorber", content[0])]
+        return [(f"absorber.{i}", item) for i, item in enumerate(content)]
+    if isinstance(content, list):
+        raise SceneError("absorber", "several absorbers ([[absorber]]) need a version-2 scene "
+                                     "(put version = 2 at the top)")
+    raise SceneError("absorber", f"must be a table [absorber], got {type(content).__name__}")
+
+
+def scene_from_dict(data: dict[str, Any]) -> Scene:
+    """Build a validated :class:`Scene` from a parsed TOML mapping (version 1 or 2)."""
+    if not isinstance(data, dict):
+        raise SceneError("", "a scene must be a table of tables")
+    allowed = list(ELEMENT_TABLES) + ["contact", "conventions"] + list(_TOP_LEVEL_SCALARS)
+    for key in data:
+        if key not in allowed:
+            raise SceneError(key, f"unknown key{suggestion(key, allowed)}")
+    version = _version(data)
+    if version == 1:
+        for table in _REQUIRED_V1:
+            if table not in data:
+                raise SceneError(table, f"missing required table [{table}]")
+    elif "barrel" not in data:
+        raise SceneError("barrel", "missing required table [barrel]")
+
+    tables: dict[str, Any] = {}
+    for table, cls in ELEMENT_TABLES.items():
+        if table not in data:
+            continue
+        if cls.SINCE_VERSION > version:
+            raise SceneError(table, f"[{table}] needs a version-{cls.SINCE_VERSION} scene "
+                                    f"(put version = {cls.SINCE_VERSION} at the top)")
+        if cls.MANY:
+            continue
+        tables[table] = cls.from_mapping(data[table], table, version)
+    absorbers = [ELEMENT_TABLES["absorber"].from_mapping(content, key, version)
+                 for key, content in _absorber_entries(data, version)]
+    if "contact" in data:
+        if len(absorbers) != 1:
+            raise SceneError("absorber", "missing: a [contact] table needs an [absorber] to touch"
+                             if not absorbers else "a top-level [contact] needs exactly one absorber: give each "
+                                                   "[[absorber]] its own [absorber.contact]")
+        if absorbers[0].contact is not None:
+            raise SceneError("contact", "given twice: as [contact] and as [absorber.contact]")
+        contact = Contact.from_mapping(data["contact"], "contact", version)
+        absorbers[0] = replace(absorbers[0], contact=contact)
+    elif version == 1 and absorbers:
+        raise SceneError("contact", "missing: an [absorber] needs a [contact] table (wall A drives it)")
+    conventions = Conventions()
+    if "conventions" in data:
+        conventions = _conventions(data["conventions"])
+    name = data.get("name", "unnamed scene")
+    return Scene(name=name, conventions=conventions, absorbers=tuple(absorbers), **tables)
+
+
+def _conventions(content) -> Conventions:
+    if not isinstance(content, dict):
+        raise SceneError("conventions", f"must be a table [conventions], got {type(content).__name__}")
+    names = [name for name in Conventions.__dataclass_fields__]
+    for key in content:
+        if key not in names:
+            raise SceneError(f"conventions.{key}", f"unknown key{suggestion(key, names)}")
+    return Conventions(**content)
+
+
+def load_scene(path: str | Path) -> Scene:
+    """Read a scene TOML file; raise :class:`SceneError` for unreadable, malformed or invalid files."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise SceneError("", f"scene file not found: {path}") from None
+    except IsADirectoryError:
+        raise SceneError("", f"scene path is a directory, not a file: {path}") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise SceneError("", f"cannot read scene file {path}: {exc}") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError("", f"malformed TOML in {path}: {exc}") from None
+    return scene_from_dict(data)
+
+
+def scene_to_dict(scene: Scene) -> dict[str, Any]:
+    """The version-2 TOML mapping of a scene (inverse of :func:`scene_from_dict`); omits absent tables."""
+    out: dict[str, Any] = {"version": FORMAT_VERSION, "name": scene.name}
+    for table, cls in ELEMENT_TABLES.items():
+        if cls.MANY:
+            items = getattr(scene, table + "s")
+            if items:
+                out[table] = [item.to_mapping() for item in items]
+            continue
+        value = getattr(scene, table)
+        if value is not None:
+            out[table] = value.to_mapping()
+    active = {name: True for name in scene.conventions.active}
+    if active:
+        out["conventions"] = active
+    return out
+
+
+def _toml_value(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        if not math.isfinite(value):
+            raise SceneError("", f"cannot write non-finite number {value}")
+        return repr(value)
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, str):
+        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    raise TypeError(f"cannot write {type(value).__name__} to TOML")
+
+
+def _table_lines(header: str, values: dict[str, Any], path: str) -> list[str]:
+    lines = ["", header]
+    nested = []
+    for key, value in values.items():
+        if isinstance(value, dict):
+            nested.append((key, value))
+        else:
+            lines.append(f"{key} = {_toml_value(value)}")
+    for key, value in nested:
+        lines += _table_lines(f"[{path}.{key}]", value, f"{path}.{key}")
+    return lines
+
+
+def scene_to_toml(scene: Scene) -> str:
+    """Serialise a scene to version-2 TOML text (round-trips through :func:`load_scene`)."""
+    data = scene_to_dict(scene)
+    lines = [f"version = {data.pop('version')}", f"name = {_toml_value(data.pop('name'))}"]
+    for table, values in data.items():
+        if isinstance(values, list):
+            for item in values:
+                lines += _table_lines(f"[[{table}]]", item, table)
+        else:
+            lines += _table_lines(f"[{table}]", values, table)
+    return "\n".join(lines) + "\n"
+
+
+__all__ = ["FORMAT_VERSION", "FORMAT_VERSIONS", "load_scene", "scene_from_dict", "scene_to_dict", "scene_to_toml"]
