@@ -6,9 +6,9 @@ Public API (one entry point per task)::
     result = simulate(model_ii(absorber_mass=1000.0, gap=0.04), end_time=10.0)
     print(result.max_barrel_displacement)
 
-Scene handling (:mod:`.scene`, :mod:`.scene_io`, :mod:`.models`) is imported eagerly and needs no
-Exudyn; the engine (:mod:`.simulation` and below) is imported on first use, so that the independent
-``validation`` package can read scenes without ever loading Exudyn.
+Scenes (:mod:`.scene`) and their elements' tables (:mod:`.elements`) are imported eagerly and need no
+Exudyn; the engine (:mod:`.engine`), results (:mod:`.results`) and studies are imported on first use,
+so that scenes can be read, checked and written without ever loading Exudyn.
 """
 
 from __future__ import annotations
@@ -24,16 +24,21 @@ __version__ = "0.1.0"
 
 # name -> module that defines it; loaded lazily (PEP 562) because these import Exudyn.
 _LAZY = {
-    "simulate": ".simulation",
-    "Result": ".result",
-    "Impact": ".result",
-    "SolverSettings": ".accuracy",
-    "ACCURACY_PRESETS": ".accuracy",
-    "solver_settings_for": ".accuracy",
-    "assemble": ".assembly",
-    "Assembly": ".assembly",
-    "FINAL_METRICS": ".final_metrics",   # names accepted by simulate(..., stop_when_final=...)
-    "EnergyBounds": ".final_metrics",
+    "simulate": ".engine.simulation",
+    "Result": ".results.result",
+    "Impact": ".results.result",
+    "ContactOutput": ".results.result",
+    "SolverSettings": ".engine.accuracy",
+    "ACCURACY_PRESETS": ".engine.accuracy",
+    "solver_settings_for": ".engine.accuracy",
+    "assemble": ".engine.assembly",
+    "Assembly": ".engine.assembly",
+    "Mechanism": ".engine.mechanism",
+    "FINAL_METRICS": ".engine.final_metrics",   # names accepted by simulate(..., stop_when_final=...)
+    "EnergyBounds": ".engine.final_metrics",
+    "add_contact": ".elements.contact_laws",
+    "add_recoil_damper": ".elements.recoil_damper",
+    "add_body": ".engine.assembly",
 }
 
 __all__ = [

@@ -30,7 +30,7 @@ from typing import Callable
 
 import numpy as np
 
-from .ops import NUMPY_OPS, Ops, make_user_function, ops_for
+from .ops import NUMPY_OPS, PYTHON_OPS, Ops, make_user_function, ops_for
 
 #: The name of the ground as a connector end.
 GROUND = "ground"
@@ -99,6 +99,10 @@ class Connector:
     def force(self, d, rate, t=None):
         """The force (N) on arrays of ``d`` (m), ``rate`` (m/s) at times ``t`` (s): numpy backend."""
         return self.law(d, rate, NUMPY_OPS)
+
+    def python_force(self, d: float, rate: float) -> float:
+        """The force (N) at one state (plain floats)."""
+        return self.law(d, rate, PYTHON_OPS)
 
     # ------------------------------------------------------------------ Exudyn
     def add_items(self, mbs, marker_a, marker_b, user_functions: str = "symbolic"):

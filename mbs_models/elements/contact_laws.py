@@ -52,7 +52,7 @@ import numpy as np
 
 from ..errors import SceneError
 from .connector import Connector
-from .ops import NUMPY_OPS, PYTHON_OPS, Ops, make_user_function, ops_for
+from .ops import NUMPY_OPS, PYTHON_OPS, Ops
 from .table import Rule, Table, check_choice
 
 #: Restitution-law impacts slower than this (m/s) are damped as if they came at this speed.
@@ -413,6 +413,15 @@ class ContactConnector(Connector):
         """The force (N) at one state with the law's current ``v-`` (plain floats)."""
         return self.law(d, rate, PYTHON_OPS)
 
+    def python_elastic(self, d: float) -> float:
+        """Elastic energy (J) at ``d`` (plain floats): ``p^(n+1) / ((n+1)/k)`` for p > 0, else 0."""
+        p = d - self.offset
+        if p <= 0.0:
+            return 0.0
+        if self.law_name == "kelvin-voigt":
+            return 0.5 * self.contact_stiffness * p * p
+        return p ** (self.exponent + 1.0) / ((self.exponent + 1.0) / self.contact_stiffness)
+
     # ------------------------------------------------------------------ energy
     @property
     def stores_energy(self) -> bool:
@@ -445,8 +454,7 @@ class ContactConnector(Connector):
 
     def penetration_bound(self, energy: float) -> float:
         """Bound (m) on p from the contact's own potential: ``((n+1) E / k)^(1/(n+1))``, ``sqrt(2E/k)`` for KV."""
-        energy = max(energy, 0.0)
-        return ((self.exponent + 1.0) * energy / self.contact_stiffness) ** (1.0 / (self.exponent + 1.0))
+        return ((self.exponent + 1.0) / self.contact_stiffness * max(energy, 0.0)) ** (1.0 / (self.exponent + 1.0))
 
     def force_bound(self, d_bound: float, rate_bound: float, energy: float) -> float:
         """Bound (N) on F given a bound on the penetration (``d_bound``, m) and on |p'| (m/s)."""

@@ -80,3 +80,16 @@ class RecoilDamperConnector(Connector):
     def linear_damping(self) -> float:
         """The larger coefficient (N s/m): what the linearised mechanism uses."""
         return max(self.damper.recoil, self.damper.counter_recoil)
+
+
+def add_recoil_damper(mbs, marker_ground, marker_barrel, damper: RecoilDamper,
+                      user_functions: str = "symbolic") -> RecoilDamperConnector:
+    """Add the asymmetric recoil damper between two coordinate markers of your own Exudyn system.
+
+    The force ``c(v) v`` with ``v`` the rate of ``x_barrel - x_ground`` (Eqs. 2-3); a symmetric damper is
+    Exudyn's built-in linear damper, an asymmetric one a user function (``"symbolic"`` or ``"python"``).
+    Returns the connector (``.index`` is the Exudyn item; keep it as long as ``mbs``).
+    """
+    connector = RecoilDamperConnector(damper)
+    connector.add_items(mbs, marker_ground, marker_barrel, user_functions)
+    return connector

@@ -17,9 +17,9 @@ from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from typing import Callable, Iterable, Sequence, TypeVar
 
-from .accuracy import SolverSettings
-from .errors import SceneError, SimulationError
-from .scene import Scene
+from ..engine.accuracy import SolverSettings
+from ..errors import SceneError, SimulationError
+from ..scene import Scene
 
 Progress = Callable[[int, int], None]
 T = TypeVar("T")
@@ -53,7 +53,7 @@ class SweepPoint:
 
 
 def _run_one(job: tuple[Scene, float, str | SolverSettings, tuple[str, ...]]) -> SweepPoint:
-    from .simulation import simulate
+    from ..engine.simulation import simulate
 
     scene, end_time, accuracy, stop_when_final = job
     try:
@@ -87,14 +87,14 @@ def run_sweep(scenes: Sequence[Scene], end_time: float = 10.0, accuracy: str | S
     scenes = list(scenes)
     if not all(isinstance(s, Scene) for s in scenes):
         raise SceneError("scenes", "every item of a sweep must be a Scene")
-    from .final_metrics import check_metric_names
+    from ..engine.final_metrics import check_metric_names
     stop_when_final = check_metric_names(stop_when_final)
     jobs = [(scene, end_time, accuracy, stop_when_final) for scene in scenes]
     if not jobs:
         return []
     # validate the shared arguments once, in this process, so that bad input fails fast
-    from .simulation import _check_arguments
-    from .accuracy import solver_settings_for
+    from ..engine.simulation import _check_arguments
+    from ..engine.accuracy import solver_settings_for
     _check_arguments(scenes[0], end_time, 0.0)
     solver_settings_for(accuracy)
 

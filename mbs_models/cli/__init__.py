@@ -13,8 +13,8 @@ import time
 from pathlib import Path
 from typing import Sequence
 
-from .errors import SceneError, SimulationError
-from .scene_io import load_scene
+from ..errors import SceneError, SimulationError
+from ..scene import load_scene
 
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
 _ARGUMENT_NAMES = {"end_time": "--end-time", "accuracy": "--accuracy", "impact_threshold": "--impact-threshold",
@@ -36,23 +36,23 @@ def _resolve_scene(path: str):
     """A scene file path, or the name of a shipped scene (``simplified``, ``model_i``, ``model_ii``)."""
     candidate = Path(path)
     if not candidate.exists() and candidate.suffix == "" and "/" not in path:
-        from .scenes import list_scenes, scene_path
+        from ..scenes import list_scenes, scene_path
         if path in list_scenes():
             candidate = scene_path(path)
     return load_scene(candidate)
 
 
 def _cmd_run(args) -> int:
-    from .simulation import simulate
+    from ..engine.simulation import simulate
 
     scene = _resolve_scene(args.scene)
     if args.plot:
-        from .outputs import prepare_output_dir
+        from ..outputs import prepare_output_dir
         prepare_output_dir(Path(args.plot).parent or Path("."), key="--plot")
     result = simulate(scene, args.end_time, args.accuracy, user_functions=args.user_functions,
                       impact_threshold=args.impact_threshold)
     if args.plot:
-        from .plotting import plot_result, save_figure
+        from ..results.plotting import plot_result, save_figure
         save_figure(plot_result(result), args.plot)
     if args.json:
         print(json.dumps(result.metrics(), indent=2, allow_nan=False))
@@ -102,7 +102,7 @@ def _cmd_validate(args) -> int:
 def _cmd_precision(args) -> int:
     from validation.studies.precision import preset_study, run_study
 
-    from .outputs import prepare_output_dir
+    from ..outputs import prepare_output_dir
 
     scene = _resolve_scene(args.scene)
     if not 0.0 < args.end_time <= 1e4:

@@ -14,7 +14,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from .outputs import atomic_write_bytes
+from ..outputs import atomic_write_bytes
 from .result import Result
 
 #: One colour per model, used consistently in every figure.

@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
-from .errors import SceneError
+from ..errors import SceneError
 
 #: Exudyn solvers with automatic step-size control.
 ADAPTIVE_SOLVERS = ("DOPRI5", "ODE23")

@@ -2,16 +2,18 @@
 
 Three questions, answered from the scene alone (before the solve) or from the step data (after it):
 
-1. **How fast is the contact?**  :func:`estimate_contact` linearises Hunt-Crossley at the expected
-   maximum penetration: the undamped impact of the reduced mass ``m_red = M m / (M + m)`` at the
-   approach speed ``v_imp`` (the initial barrel speed v0: the absorber starts at rest, and across the
-   hard-case grid of ``tests/test_hard_cases.py`` no later impact approached faster) stops at
-   ``p = ((n+1) m_red v_imp^2 / (2 k_c))^(1/(n+1))``.  There the contact has the tangent stiffness
-   ``n k_c p^(n-1)``, the damping ``lambda k_c p^n`` and the natural frequency
-   ``omega = sqrt(n k_c p^(n-1) / m_red)``; the impact lasts ``T = 2 (p / v_imp) I(n)``,
+1. **How fast is each contact?**  :func:`estimate_contacts` linearises each contact's law at the
+   expected maximum penetration: the undamped impact of the reduced mass of its two bodies
+   (``m_red = M m / (M + m)``; the body's mass against the ground) at the approach speed ``v_imp``
+   (the initial barrel speed v0: the absorbers start at rest, and across the hard-case grid no later
+   impact approached faster) stops at ``p = ((n+1) m_red v_imp^2 / (2 k))^(1/(n+1))`` (n = 1 for
+   Kelvin-Voigt).  There the contact has the tangent stiffness ``n k p^(n-1)``, the damping
+   ``lambda k p^n`` (``c`` for Kelvin-Voigt; ``lambda = chi / v_imp`` for the restitution laws) and the
+   natural frequency ``omega = sqrt(n k p^(n-1) / m_red)``; the impact lasts ``T = 2 (p / v_imp) I(n)``,
    ``I(n) = int_0^1 ds / sqrt(1 - s^(n+1))`` (``pi / omega`` for n = 1).  A hard bound is reported
    too: the elastic contact energy never exceeds the initial energy ``E0``, so
-   ``p <= ((n+1) E0 / k_c)^(1/(n+1))`` (unless the ``literal_lambda_sign`` convention injects energy).
+   ``p <= ((n+1) E0 / k)^(1/(n+1))`` (unless the ``literal_lambda_sign`` convention injects energy).
+   :func:`estimate_contact` is the fastest contact's estimate.
 
 2. **Is a solver setting safe?**  :func:`check_settings` (called by :func:`~mbs_models.simulate`
    before solving) linearises the whole mechanism, out of contact and in contact at ``p``, ``p/2``,
@@ -49,10 +51,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import forces
+from ..elements.connector import GROUND
+from ..errors import SceneError
+from ..scene import Scene
 from .accuracy import ADAPTIVE_SOLVERS, IMPLICIT_SOLVERS, SolverSettings
-from .errors import SceneError
-from .scene import Scene
+from .mechanism import Mechanism
 
 #: A fixed-step solver should resolve an impact with at least this many steps (else a warning) ...
 STEPS_PER_CONTACT = 10
@@ -131,89 +134,96 @@ def _duration_integral(n: float) -> float:
 
 
 def initial_energy(scene: Scene) -> float:
-    """Energy at t = 0 in J: kinetic, plus elastic contact energy of an initial interference."""
-    energy = scene.initial_kinetic_energy
-    if scene.contact is not None:
-        energy += float(forces.contact_elastic_energy(0.0, scene.contact, scene.conventions))
-    return energy
+    """Energy at t = 0 in J: kinetic, plus the stored energy of an initial interference."""
+    return Mechanism(scene).initial_energy()
 
 
-def estimate_contact(scene: Scene) -> ContactEstimate | None:
-    """The contact's penetration, stiffness, frequency and duration (see the module docstring).
+def _mechanism(scene) -> Mechanism:
+    return scene if isinstance(scene, Mechanism) else Mechanism(scene)
 
-    None for a scene without contact.
-    """
-    if scene.contact is None or scene.absorber is None:
+
+def _reduced_mass(mechanism: Mechanism, connector) -> float:
+    masses = [mechanism.bodies[mechanism.body_index[p]].mass for p in (connector.a, connector.b) if p != GROUND]
+    return masses[0] if len(masses) == 1 else masses[0] * masses[1] / (masses[0] + masses[1])
+
+
+def estimate_contacts(scene: Scene | Mechanism) -> dict[str, ContactEstimate]:
+    """Each contact's penetration, stiffness, frequency and duration (see the module docstring), by name."""
+    mechanism = _mechanism(scene)
+    out = {}
+    energy = mechanism.initial_energy()
+    v0 = mechanism.scene.initial_velocity
+    for contact in mechanism.contacts:
+        n, k = contact.exponent, contact.contact_stiffness
+        m_red = _reduced_mass(mechanism, contact)
+        interference = float(contact.stored_energy(0.0))
+        speed = math.sqrt(v0 ** 2 + 2.0 * interference / m_red)
+        bound = ((n + 1.0) * energy / k) ** (1.0 / (n + 1.0))
+        p = min(contact.impact_penetration(m_red, speed), bound)
+        if p <= 0.0:  # nothing moves: a scene at rest never touches
+            out[contact.name] = ContactEstimate(energy=energy, reduced_mass=m_red, impact_speed=0.0, penetration=0.0,
+                                                max_penetration=bound, stiffness=0.0, damping=0.0,
+                                                natural_frequency=0.0, duration=math.inf)
+            continue
+        stiffness = n * k * p ** (n - 1.0)
+        _, damping = contact.tangent(p, 0.0, speed)
+        out[contact.name] = ContactEstimate(
+            energy=energy, reduced_mass=m_red, impact_speed=speed, penetration=p, max_penetration=bound,
+            stiffness=stiffness, damping=damping, natural_frequency=math.sqrt(stiffness / m_red),
+            duration=2.0 * p / speed * _duration_integral(n))
+    return out
+
+
+def estimate_contact(scene: Scene | Mechanism) -> ContactEstimate | None:
+    """The fastest contact's estimate (the shortest impact); None for a scene without contact."""
+    estimates = estimate_contacts(scene)
+    if not estimates:
         return None
-    contact = scene.contact
-    kc, n, lam = contact.stiffness, contact.exponent, contact.damping_factor
-    M, m = scene.barrel.mass, scene.absorber.mass
-    m_red = M * m / (M + m)
-    energy = initial_energy(scene)
-    interference = energy - scene.initial_kinetic_energy
-    speed = math.sqrt(scene.initial_velocity ** 2 + 2.0 * interference / m_red)
-    bound = ((n + 1.0) * energy / kc) ** (1.0 / (n + 1.0))
-    p = min(((n + 1.0) * 0.5 * m_red * speed ** 2 / kc) ** (1.0 / (n + 1.0)), bound)
-    if p <= 0.0:  # nothing moves: a scene at rest never touches
-        return ContactEstimate(energy=energy, reduced_mass=m_red, impact_speed=0.0, penetration=0.0,
-                               max_penetration=bound, stiffness=0.0, damping=0.0, natural_frequency=0.0,
-                               duration=math.inf)
-    stiffness = n * kc * p ** (n - 1.0)
-    return ContactEstimate(
-        energy=energy, reduced_mass=m_red, impact_speed=speed, penetration=p, max_penetration=bound,
-        stiffness=stiffness, damping=lam * kc * p ** n, natural_frequency=math.sqrt(stiffness / m_red),
-        duration=2.0 * p / speed * _duration_integral(n))
+    return min(estimates.values(), key=lambda e: e.duration)
 
 
 # ------------------------------------------------------------------------------------------------
 # Linearised mechanism
 
-def linearised_systems(scene: Scene) -> list[tuple[str, np.ndarray]]:
+def linearised_systems(scene: Scene | Mechanism) -> list[tuple[str, np.ndarray]]:
     """State matrices ``A`` (x' = A x, x = [positions, velocities]) of the linearised mechanism.
 
-    One out of contact, and (with an absorber) one in contact at each depth of
-    :data:`_LINEARISATION_DEPTHS` times the expected penetration (:func:`estimate_contact`).  The recoil damper takes its larger
-    coefficient.  Returns ``(label, A)`` pairs.
+    One out of contact (every spring and damper; an asymmetric damper with its larger coefficient), and
+    for each contact in turn one in contact at each depth of :data:`_LINEARISATION_DEPTHS` times its
+    expected penetration (:func:`estimate_contacts`).  Returns ``(label, A)`` pairs.
     """
-    M = scene.barrel.mass
-    damper = max(scene.recoil_damper.recoil, scene.recoil_damper.counter_recoil)
-    if scene.absorber is None:
-        A = np.array([[0.0, 1.0], [-scene.recoil_spring.stiffness / M, -damper / M]])
-        return [("free", A)]
-    absorber = scene.absorber
-    masses = np.array([M, absorber.mass])
-    base_k = np.zeros((2, 2))
-    base_c = np.zeros((2, 2))
-    base_k[0, 0] += scene.recoil_spring.stiffness
-    base_c[0, 0] += damper
-    between = np.array([[1.0, -1.0], [-1.0, 1.0]])
-    if absorber.mount == "ground":
-        base_k[1, 1] += absorber.stiffness
-        base_c[1, 1] += absorber.damping
-    else:
-        base_k += absorber.stiffness * between
-        base_c += absorber.damping * between
+    mechanism = _mechanism(scene)
+    masses = mechanism.masses
+    n = len(masses)
+    base_k = np.zeros((n, n))
+    base_c = np.zeros((n, n))
+    for connector in mechanism.connectors:
+        if connector.is_contact:
+            continue
+        g = mechanism.direction(connector)
+        base_k += connector.linear_stiffness * np.outer(g, g)
+        base_c += connector.linear_damping * np.outer(g, g)
 
     def state_matrix(K, C):
-        A = np.zeros((4, 4))
-        A[:2, 2:] = np.eye(2)
-        A[2:, :2] = -K / masses[:, None]
-        A[2:, 2:] = -C / masses[:, None]
+        A = np.zeros((2 * n, 2 * n))
+        A[:n, n:] = np.eye(n)
+        A[n:, :n] = -K / masses[:, None]
+        A[n:, n:] = -C / masses[:, None]
         return A
 
     systems = [("free", state_matrix(base_k, base_c))]
-    estimate = estimate_contact(scene)
-    contact = scene.contact
-    kc, n = contact.stiffness, contact.exponent
-    lam = -contact.damping_factor if scene.conventions.literal_lambda_sign else contact.damping_factor
-    for depth in _LINEARISATION_DEPTHS if estimate.penetration > 0 else ():
-        # on the undamped impact at this depth the penetration rate is v_imp sqrt(1 - depth^(n+1))
-        p = depth * estimate.penetration
-        rate = estimate.impact_speed * math.sqrt(max(0.0, 1.0 - depth ** (n + 1.0)))
-        k_lin = n * kc * p ** (n - 1.0) * max(0.0, 1.0 + lam * rate)
-        c_lin = abs(lam) * kc * p ** n
-        systems.append((f"in contact at p = {p:.3g} m", state_matrix(base_k + k_lin * between,
-                                                                   base_c + c_lin * between)))
+    estimates = estimate_contacts(mechanism)
+    several = len(estimates) > 1
+    for contact in mechanism.contacts:
+        estimate = estimates[contact.name]
+        g = mechanism.direction(contact)
+        for depth in _LINEARISATION_DEPTHS if estimate.penetration > 0 else ():
+            # on the undamped impact at this depth the penetration rate is v_imp sqrt(1 - depth^(n+1))
+            p = depth * estimate.penetration
+            rate = estimate.impact_speed * math.sqrt(max(0.0, 1.0 - depth ** (contact.exponent + 1.0)))
+            k_lin, c_lin = contact.tangent(p, rate, estimate.impact_speed)
+            label = f"{contact.name} in contact at p = {p:.3g} m" if several else f"in contact at p = {p:.3g} m"
+            systems.append((label, state_matrix(base_k + k_lin * np.outer(g, g), base_c + c_lin * np.outer(g, g))))
     return systems
 
 
@@ -328,7 +338,7 @@ def check_energy_balance(scene: Scene, time: np.ndarray, error: np.ndarray, solv
     """Refuse a solve whose energy balance (``error`` in J at ``time``) is off by more than
     :data:`ENERGY_FAILURE` of the initial energy: its numbers would be garbage.  Warn (AccuracyWarning)
     above :data:`ENERGY_WARNING`."""
-    from .errors import SimulationError
+    from ..errors import SimulationError
 
     energy = max(initial_energy(scene), 1e-300)
     relative = np.abs(np.asarray(error, dtype=float)) / energy
@@ -369,20 +379,25 @@ def _cubic_coefficients(h, y0, y1, d0, d1):
     return 2 * y0 + d0 - 2 * y1 + d1, -3 * y0 - 2 * d0 + 3 * y1 - d1, d0, y0
 
 
-def stepped_over_contacts(scene: Scene, time: np.ndarray, relative_position: np.ndarray,
+def stepped_over_contacts(contact, time: np.ndarray, relative_position: np.ndarray,
                           relative_velocity: np.ndarray, contact_force: np.ndarray,
                           impact_threshold: float) -> list[SteppedOverContact]:
     """Contacts the solver stepped over: see the module docstring (point 3).
 
-    ``relative_position`` is x_M - x_m (m), ``relative_velocity`` its rate (m/s), at the output times
-    ``time`` (s); ``contact_force`` the force (N) the solver recorded there.  Only touches whose
-    free-motion peak force exceeds ``MISSED_CONTACT_FORCE_FRACTION * impact_threshold`` and whose
-    penetration exceeds :data:`PENETRATION_NOISE` are reported.
+    ``contact`` is a contact connector (or a scene with one absorber: its contact);
+    ``relative_position`` is its d (m; x_M - x_m for an absorber), ``relative_velocity`` its rate
+    (m/s), at the output times ``time`` (s); ``contact_force`` the force (N) the solver recorded there.
+    Only touches whose free-motion peak force exceeds ``MISSED_CONTACT_FORCE_FRACTION * impact_threshold``
+    and whose penetration exceeds :data:`PENETRATION_NOISE` are reported.
     """
-    if scene.contact is None or len(time) < 2:
+    if isinstance(contact, Scene):
+        contacts = Mechanism(contact).absorber_contacts
+        if not contacts:
+            return []
+        contact = contacts[0]
+    if len(time) < 2:
         return []
-    contact, conventions = scene.contact, scene.conventions
-    penetration = forces.contact_penetration(np.asarray(relative_position, dtype=float), contact, conventions)
+    penetration = contact.penetration(np.asarray(relative_position, dtype=float))
     quiet = (contact_force[:-1] <= 0) & (contact_force[1:] <= 0) & (penetration[:-1] <= 0) & (penetration[1:] <= 0)
     candidates = np.flatnonzero(quiet)
     if not len(candidates):
@@ -407,7 +422,7 @@ def stepped_over_contacts(scene: Scene, time: np.ndarray, relative_position: np.
     for j in np.flatnonzero(best_p > PENETRATION_NOISE):
         i = candidates[j]
         p = float(best_p[j])
-        force = contact.stiffness * p ** contact.exponent
+        force = contact.peak_force_estimate(p)
         if force <= floor_force:
             continue
         # how long the cubic stays above 0 (grid estimate, enough for choosing a step)

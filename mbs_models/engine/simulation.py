@@ -2,17 +2,17 @@
 
 Contract
 --------
-* The scene is assembled with only the items it calls for (:mod:`mbs_models.assembly`).
+* The scene is assembled with only the items its elements call for (:mod:`mbs_models.engine.assembly`).
 * ``accuracy`` is a preset name (``"draft"``, ``"standard"`` default, ``"reference"``) or explicit
   :class:`~mbs_models.accuracy.SolverSettings`.
 * The return value is a complete :class:`~mbs_models.result.Result`, or a
   :class:`~mbs_models.errors.SimulationError` is raised: a solver that fails, stops before
   ``end_time``, or produces NaN/inf never yields a result.  The one exception is asked for:
   ``stop_when_final`` stops the solve once energy bounds prove the named metrics final
-  (:mod:`mbs_models.final_metrics`); the result says so (``stop_reason``, ``requested_end_time``)
+  (:mod:`mbs_models.engine.final_metrics`); the result says so (``stop_reason``, ``requested_end_time``)
   and holds None for every metric not proven final.  Bad arguments raise
   :class:`~mbs_models.errors.SceneError` naming the argument.
-* Numerical safety (:mod:`mbs_models.stability`): a fixed step that is unstable for the scene or
+* Numerical safety (:mod:`mbs_models.engine.stability`): a fixed step that is unstable for the scene or
   would step over an impact is refused before solving (SceneError, key ``step``, with the safe
   limit); an adaptive solver that stepped over a whole (grazing) contact is re-run with a smaller
   ``max_step`` (the result's ``settings`` say which); a solve whose energy balance is off by more
@@ -30,17 +30,17 @@ from typing import Sequence
 import exudyn
 import numpy as np
 
+from ..errors import SceneError, SimulationError
+from ..results.postprocess import Samples, analyse
+from ..results.result import Result
+from ..scene import Scene
 from . import stability
 from .accuracy import MIN_RELATIVE_TOLERANCE, SolverSettings, solver_settings_for
 from .assembly import Assembly, assemble
-from .errors import SceneError, SimulationError
 from .final_metrics import (ENERGY_SLACK, FINAL_METRICS, STOP_END_TIME, STOP_ENERGY_CHECK, STOP_METRICS_FINAL, STOP_NO_BOUND,
-                            FinalityTracker, check_metric_names, dissipative,
-                            largest_energy_rise)
+                            FinalityTracker, check_metric_names, dissipative, largest_energy_rise)
 from .guard import StepBudget, step_budget
-from .postprocess import Samples, analyse
-from .result import Result
-from .scene import Scene
+from .mechanism import Mechanism
 
 #: Longest simulated time accepted, in s.
 MAX_END_TIME = 1.0e4
@@ -120,34 +120,51 @@ def _absolute_tolerance_settings(settings: SolverSettings) -> SolverSettings | N
 
 
 def _pre_step_function(assembly: Assembly, budget: StepBudget | None, tracker: FinalityTracker | None):
-    """Exudyn pre-step function: the step budget (raises when spent) and the finality tracker.
+    """Exudyn pre-step function: the step budget (raises when spent), the contacts' onset capture and
+    the finality tracker.
 
     The budget *raises* when spent: returning False is ignored while Exudyn's DOPRI5 is stuck
     re-trying one step at its minimum step size (measured: model (ii) with m = 1 kg, k_c = 1e12 at
-    rtol <= 1e-10 never passes t = 0.4924 s).  The tracker is shown the state at the start of every
-    :data:`OBSERVE_EVERY`-th step (Exudyn's current coordinates; ``t`` is the end of the step about to
-    be taken); the function returns False once every requested metric is final: Exudyn then
-    completes that step and stops, so the output ends one step after the state that proved finality.
+    rtol <= 1e-10 never passes t = 0.4924 s).  Contacts whose law needs the onset rate ``v-`` see the
+    state at the start of every step (Exudyn's current coordinates; ``t`` is the end of the step
+    about to be taken, so the start is ``t - currentStepSize``).  The tracker is shown the state at the
+    start of every :data:`OBSERVE_EVERY`-th step; the function returns False once every requested metric
+    is final: Exudyn then completes that step and stops, so the output ends one step after the state
+    that proved finality.
     """
     data = assembly.mbs.systemData
-    barrel = data.GetNodeLTGODE2(assembly.nodes["barrel"])[0]
-    absorber = data.GetNodeLTGODE2(assembly.nodes["absorber"])[0] if "absorber" in assembly.nodes else None
+    mechanism = assembly.mechanism
+    order = [assembly.coordinates[body.name] for body in mechanism.bodies]
+    captures = []
+    for contact in mechanism.capturing_contacts:
+        ia = None if contact.a == "ground" else assembly.coordinates[contact.a]
+        ib = None if contact.b == "ground" else assembly.coordinates[contact.b]
+        captures.append((contact.capture, ia, ib))
     calls = [0]
+    solver = []
 
     def pre_step(mbs, t):
         if budget is not None and not budget(mbs, t):
             raise _BudgetSpent(f"step budget spent at t = {t:.6g} s")
+        q = v = None
+        if captures:
+            q = data.GetODE2Coordinates(copy=False).tolist()
+            v = data.GetODE2Coordinates_t(copy=False).tolist()
+            if not solver:
+                solver.append(mbs.sys["dynamicSolver"].it)
+            t_start = t - solver[0].currentStepSize
+            for capture, ia, ib in captures:
+                d = (q[ib] if ib is not None else 0.0) - (q[ia] if ia is not None else 0.0)
+                rate = (v[ib] if ib is not None else 0.0) - (v[ia] if ia is not None else 0.0)
+                capture.observe(t_start, d, rate)
         if tracker is not None:
             calls[0] += 1
             if calls[0] % OBSERVE_EVERY:
                 return True
-            q = data.GetODE2Coordinates(copy=False).tolist()
-            v = data.GetODE2Coordinates_t(copy=False).tolist()
-            if absorber is None:
-                done = tracker.observe(t, q[barrel], v[barrel])
-            else:
-                done = tracker.observe(t, q[barrel], v[barrel], q[absorber], v[absorber])
-            if done:
+            if q is None:
+                q = data.GetODE2Coordinates(copy=False).tolist()
+                v = data.GetODE2Coordinates_t(copy=False).tolist()
+            if tracker.observe(t, [q[i] for i in order], [v[i] for i in order]):
                 return False
         return True
 
@@ -165,9 +182,9 @@ def _solve(assembly: Assembly, settings: SolverSettings, end_time: float,
     ss = exudyn_simulation_settings(settings, end_time)
     solver_type = getattr(exudyn.DynamicSolverType, settings.solver)
     budget = None
-    if settings.adaptive and assembly.scene.contact is not None:
+    if settings.adaptive and assembly.mechanism.contacts:
         budget = StepBudget(step_budget(end_time))
-    if budget is not None or tracker is not None:
+    if budget is not None or tracker is not None or assembly.mechanism.capturing_contacts:
         mbs.SetPreStepUserFunction(_pre_step_function(assembly, budget, tracker))
     print_to_console = exudyn.config.printToConsole
     exudyn.config.printToConsole = False  # Exudyn's own failure banner; we raise with the reason instead
@@ -225,7 +242,7 @@ def _stored(assembly: Assembly, name: str) -> np.ndarray:
 
 
 def _collect(assembly: Assembly, end_time: float, settings: SolverSettings,
-             initial_accelerations: dict[str, float] | None = None) -> tuple[Samples, np.ndarray | None]:
+             initial_accelerations: dict[str, float] | None = None) -> Samples:
     """Read the sensors into :class:`Samples`; raise SimulationError for NaN/inf or missing output."""
     columns = {name: _stored(assembly, name) for name in assembly.sensors}
     for body, value in (initial_accelerations or {}).items():
@@ -245,29 +262,29 @@ def _collect(assembly: Assembly, end_time: float, settings: SolverSettings,
         raise SimulationError(f"Exudyn {settings.solver} output ends at t = {time[-1]:.6g} s, not at {end_time:g} s")
     keep = np.concatenate([[True], np.diff(time) > 0])  # drop duplicate time stamps, if any
     values = {name: data[keep, 1] for name, data in columns.items()}
-    samples = Samples(time=time[keep], barrel_position=values["barrel_position"],
-                      barrel_velocity=values["barrel_velocity"], barrel_acceleration=values["barrel_acceleration"],
-                      absorber_position=values.get("absorber_position"),
-                      absorber_velocity=values.get("absorber_velocity"),
-                      absorber_acceleration=values.get("absorber_acceleration"))
-    return samples, values.get("contact_force")
+    bodies = [body.name for body in assembly.mechanism.bodies]
+    return Samples(time=time[keep], positions={b: values[f"{b}_position"] for b in bodies},
+                   velocities={b: values[f"{b}_velocity"] for b in bodies},
+                   accelerations={b: values[f"{b}_acceleration"] for b in bodies},
+                   forces={c.name: values[f"{c.name}_force"] for c in assembly.mechanism.connectors
+                           if c.records_force})
 
 
-def _settings_after_stepped_over_contacts(scene: Scene, samples: Samples, contact_force: np.ndarray | None,
-                                          settings: SolverSettings, impact_threshold: float,
-                                          attempt: int) -> SolverSettings | None:
+def _settings_after_stepped_over_contacts(mechanism: Mechanism, samples: Samples, settings: SolverSettings,
+                                          impact_threshold: float, attempt: int) -> SolverSettings | None:
     """None if the solver felt every contact; else settings for a re-solve with a smaller max_step.
 
     A fixed-step solver, or an adaptive one still stepping over contacts after
-    :data:`MAX_CONTACT_RETRIES` re-solves, raises SimulationError (see :mod:`mbs_models.stability`).
+    :data:`MAX_CONTACT_RETRIES` re-solves, raises SimulationError (see :mod:`mbs_models.engine.stability`).
     """
-    if contact_force is None:
-        return None
-    missed = stability.stepped_over_contacts(
-        scene, samples.time, samples.barrel_position - samples.absorber_position,
-        samples.barrel_velocity - samples.absorber_velocity, contact_force, impact_threshold)
+    missed = []
+    for contact in mechanism.contacts:
+        missed += stability.stepped_over_contacts(
+            contact, samples.time, mechanism.relative(contact, samples.positions),
+            mechanism.relative(contact, samples.velocities), samples.forces[contact.name], impact_threshold)
     if not missed:
         return None
+    missed.sort(key=lambda m: m.time)
     first = missed[0]
     shortest = min(m.duration for m in missed)
     what = (f"Exudyn {settings.solver} stepped over {len(missed)} contact(s) between two steps, the first at "
@@ -324,14 +341,15 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
     t_start = _time.perf_counter()
     attempt = 0
     while True:
-        tracker = FinalityTracker(scene, requested, impact_threshold) if early_stop else None
-        assembly = assemble(scene, settings.user_functions)
+        mechanism = Mechanism(scene)  # fresh: contacts carry the onset capture of one solve
+        tracker = FinalityTracker(mechanism, requested, impact_threshold) if early_stop else None
+        assembly = assemble(scene, settings.user_functions, mechanism)
         t_assembled = _time.perf_counter()
         try:
             initial_accelerations = _initial_accelerations(assembly)
             steps, simulated_end = _solve(assembly, settings, float(end_time), tracker)
             t_solved = _time.perf_counter()
-            samples, contact_force = _collect(assembly, simulated_end, settings, initial_accelerations)
+            samples = _collect(assembly, simulated_end, settings, initial_accelerations)
         except _StepSizeStalled as stalled:
             retry = _absolute_tolerance_settings(settings) if settings.adaptive else None
             if retry is None:
@@ -340,8 +358,7 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
             continue
         finally:
             assembly.close()
-        retry = _settings_after_stepped_over_contacts(scene, samples, contact_force, settings,
-                                                      float(impact_threshold), attempt)
+        retry = _settings_after_stepped_over_contacts(mechanism, samples, settings, float(impact_threshold), attempt)
         attempt += 1
         if retry is None:
             break
@@ -349,61 +366,96 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
     stopped = tracker is not None and tracker.done
     final = FINAL_METRICS
     if stopped:  # which other metrics are final too: all of them are checked at the last state
-        last = -1
-        tracker.observe_last(float(samples.time[last]), float(samples.barrel_position[last]),
-                             float(samples.barrel_velocity[last]),
-                             *((float(samples.absorber_position[last]), float(samples.absorber_velocity[last]))
-                               if samples.absorber_position is not None else ()))
+        tracker.observe_last(float(samples.time[-1]), [float(samples.positions[b.name][-1]) for b in mechanism.bodies],
+                             [float(samples.velocities[b.name][-1]) for b in mechanism.bodies])
         final = tuple(n for n in FINAL_METRICS if n in tracker.final)
-    metrics = analyse(scene, samples, contact_force, float(impact_threshold), final)  # unproven ones: not computed
-    for name in ("max_barrel_displacement", "max_absorber_velocity", "peak_contact_force"):
-        value = getattr(metrics, name)
+    metrics = analyse(mechanism, samples, float(impact_threshold), final)  # unproven ones: not computed
+    result = _result(scene, settings, mechanism, samples, metrics, float(impact_threshold))
+    for name in ("max_barrel_displacement", "max_absorber_velocity", "peak_contact_force", "peak_support_force"):
+        value = getattr(result, name)
         if value is not None and not math.isfinite(value):
             raise SimulationError(f"post-processing produced a non-finite {name.replace('_', ' ')}")
-    dissipated_history = metrics.dissipated_energy_history
-    energy_error = (metrics.kinetic_energy_history + metrics.stored_energy_history + sum(dissipated_history.values())
-                    - stability.initial_energy(scene))
+    energy_error = (result.kinetic_energy_history + result.stored_energy_history
+                    + sum(result.dissipated_energy_history.values()) - mechanism.initial_energy())
     stability.check_energy_balance(scene, samples.time, energy_error, f"Exudyn {settings.label()}")
-    if stopped and largest_energy_rise(metrics.kinetic_energy_history + metrics.stored_energy_history) > ENERGY_SLACK:
+    if stopped and largest_energy_rise(result.kinetic_energy_history + result.stored_energy_history) > ENERGY_SLACK:
         # the solution's energy rose by more than the bounds' slack: do not trust the early stop
         result = simulate(scene, end_time, settings, impact_threshold=impact_threshold)
         result.stop_reason = STOP_ENERGY_CHECK
         result.wall_time = _time.perf_counter() - t_start
         return result
     if stopped:
-        stop_reason = STOP_METRICS_FINAL
-        _drop_unproven(metrics, final)
+        result.stop_reason = STOP_METRICS_FINAL
+        result.end_time = simulated_end
+        result.final_metrics = final
+        _drop_unproven(result, final)
     else:
-        stop_reason = STOP_NO_BOUND if requested and not early_stop else STOP_END_TIME
+        result.stop_reason = STOP_NO_BOUND if requested and not early_stop else STOP_END_TIME
+        result.end_time = float(end_time)
+    result.requested_end_time = float(end_time)
+    result.steps = steps
     t_end = _time.perf_counter()
+    result.wall_time = t_end - t_start
+    result.timings = {"assembly": t_assembled - t_start, "solve": t_solved - t_assembled, "postprocess": t_end - t_solved}
+    return result
+
+
+def _largest(candidates) -> tuple[float | None, float | None]:
+    """(value, time) with the largest value, the earliest on ties; (None, None) if there is none."""
+    candidates = [c for c in candidates if c[0] is not None]
+    if not candidates:
+        return None, None
+    return max(candidates, key=lambda c: (c[0], -(c[1] if c[1] is not None else 0.0)))
+
+
+def _result(scene: Scene, settings: SolverSettings, mechanism: Mechanism, samples: Samples, metrics,
+            impact_threshold: float) -> Result:
+    """The Result of a solve: histories, the version-1 metrics over all absorbers, per-element outputs."""
+    absorber_contacts = [metrics.contacts[c.name] for c in mechanism.absorber_contacts if c.name in metrics.contacts]
+    has_absorbers = bool(mechanism.absorber_contacts)
+    peak = time_of_peak = None
+    impacts = None
+    if has_absorbers and absorber_contacts:
+        peak, time_of_peak = _largest((c.peak_force, c.time_of_peak_force) for c in absorber_contacts)
+        if peak == 0.0:
+            time_of_peak = None
+        if all(c.impacts is not None for c in absorber_contacts):
+            impacts = sorted((i for c in absorber_contacts for i in c.impacts), key=lambda i: i.start)
+    elif not has_absorbers:
+        impacts = []
+    v_max, t_v = _largest(metrics.max_velocity.values()) if metrics.max_velocity else (None, None)
+    energies = metrics.energies
+    element_of = {body.name: body.element or body.name for body in mechanism.bodies}
+    element_of.update({c.name: c.element for c in mechanism.connectors})
     return Result(
-        scene=scene, settings=settings, end_time=simulated_end if stopped else float(end_time), time=samples.time,
-        barrel_position=samples.barrel_position, barrel_velocity=samples.barrel_velocity,
-        barrel_acceleration=samples.barrel_acceleration, absorber_position=samples.absorber_position,
-        absorber_velocity=samples.absorber_velocity, absorber_acceleration=samples.absorber_acceleration,
-        contact_force=contact_force,
+        scene=scene, settings=settings, end_time=float(samples.time[-1]), time=samples.time,
+        positions=samples.positions, velocities=samples.velocities, accelerations=samples.accelerations,
+        contacts=metrics.contacts, support_force=metrics.support_force,
         max_barrel_displacement=metrics.max_barrel_displacement,
         time_of_max_barrel_displacement=metrics.time_of_max_barrel_displacement,
-        peak_contact_force=metrics.peak_contact_force, time_of_peak_contact_force=metrics.time_of_peak_contact_force,
-        max_absorber_velocity=metrics.max_absorber_velocity,
-        time_of_max_absorber_velocity=metrics.time_of_max_absorber_velocity,
-        impacts=metrics.impacts, impact_threshold=float(impact_threshold),
-        dissipated_energy={name: float(history[-1]) for name, history in dissipated_history.items()},
-        dissipated_energy_history=dissipated_history, stored_energy_history=metrics.stored_energy_history,
-        kinetic_energy_history=metrics.kinetic_energy_history,
-        wall_time=t_end - t_start, steps=steps,
-        timings={"assembly": t_assembled - t_start, "solve": t_solved - t_assembled, "postprocess": t_end - t_solved},
-        requested_end_time=float(end_time), stop_reason=stop_reason, final_metrics=final,
-    )
+        peak_contact_force=peak, time_of_peak_contact_force=time_of_peak,
+        max_absorber_velocity=v_max, time_of_max_absorber_velocity=t_v,
+        impacts=impacts, impact_threshold=impact_threshold,
+        dissipated_energy={name: float(history[-1]) for name, history in energies.dissipated.items()},
+        peak_support_force=metrics.peak_support_force, time_of_peak_support_force=metrics.time_of_peak_support_force,
+        max_velocities=dict(metrics.max_velocity), dissipated_energy_history=energies.dissipated,
+        stored_energy_histories=energies.stored, kinetic_energy_histories=energies.kinetic, element_of=element_of)
 
 
-def _drop_unproven(metrics, final: tuple[str, ...]) -> None:
+def _drop_unproven(result: Result, final: tuple[str, ...]) -> None:
     """Set every metric not proven final (and its time) to None: a shorter window's value is no result."""
     if "max_barrel_displacement" not in final:
-        metrics.max_barrel_displacement = metrics.time_of_max_barrel_displacement = None
+        result.max_barrel_displacement = result.time_of_max_barrel_displacement = None
     if "peak_contact_force" not in final:
-        metrics.peak_contact_force = metrics.time_of_peak_contact_force = None
+        result.peak_contact_force = result.time_of_peak_contact_force = None
+        for contact in result.contacts.values():
+            contact.peak_force = contact.time_of_peak_force = None
     if "max_absorber_velocity" not in final:
-        metrics.max_absorber_velocity = metrics.time_of_max_absorber_velocity = None
+        result.max_absorber_velocity = result.time_of_max_absorber_velocity = None
+        result.max_velocities = {name: (None, None) for name in result.max_velocities}
     if "impacts" not in final:
-        metrics.impacts = None
+        result.impacts = None
+        for contact in result.contacts.values():
+            contact.impacts = None
+    if "peak_support_force" not in final:
+        result.peak_support_force = result.time_of_peak_support_force = None

@@ -1,0 +1,12 @@
+"""The engine: assembly of a scene's elements into Exudyn, the solve, and the checks around it.
+
+* :mod:`.mechanism` -- the scene as bodies and connectors (what every stage iterates over);
+* :mod:`.assembly` -- the Exudyn system;
+* :mod:`.simulation` -- :func:`simulate`, the one entry point;
+* :mod:`.accuracy` -- solver settings and the accuracy presets;
+* :mod:`.stability` -- contact time scales, unsafe steps refused, stepped-over contacts, energy balance;
+* :mod:`.guard` -- the step budget of adaptive solves;
+* :mod:`.final_metrics` -- the early stop once energy bounds prove the peak metrics final.
+
+This package imports Exudyn.
+"""

@@ -1,0 +1,125 @@
+"""Assemble a :class:`~mbs_models.scene.Scene` into an Exudyn system, adding only what its elements call for.
+
+The assembly iterates over the scene's elements (:class:`~mbs_models.engine.mechanism.Mechanism`):
+each body is a ``NodeGenericODE2`` (1 coordinate) with an ``ObjectMass1D`` and a coordinate marker and
+position/velocity/acceleration sensors; each connector an ``ObjectConnectorCoordinateSpringDamper``
+between its two markers (Exudyn's linear law, or the element's user function), and each contact a force
+sensor.  For the paper's model (ii)::
+
+    ground --[recoil_spring k]------- barrel (NodeGenericODE2 + ObjectMass1D, mass M)
+    ground --[recoil_damper c(v)]---- barrel        user function only if c is asymmetric
+    ground --[absorber_damper k_r, c_r]-- absorber (mass m)
+    absorber --[contact]----------------- barrel   (user function)
+
+An element the scene lacks adds nothing (no absorber: no absorber node, connector or sensor); a
+symmetric damper is the built-in linear one; a zero stiffness or damping leaves the connector out.
+
+The :class:`Assembly` owns the Exudyn ``SystemContainer``; call :meth:`Assembly.close` (or use it as
+a context manager) so that Exudyn releases the model -- symbolic user functions otherwise keep it alive.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import exudyn
+from exudyn.itemInterface import MarkerNodeCoordinate, NodeGenericODE2, NodePointGround, ObjectMass1D, SensorNode, SensorObject
+
+from ..elements.connector import GROUND
+from ..scene import Scene
+from .mechanism import Mechanism
+
+_OVT = exudyn.OutputVariableType
+USER_FUNCTION_BACKENDS = ("symbolic", "python")
+
+
+@dataclass
+class Assembly:
+    """An assembled Exudyn system and the indices of what was added.
+
+    Attributes
+    ----------
+    scene, mechanism: the scene and its bodies and connectors.
+    system_container, mbs: the Exudyn SystemContainer and MainSystem.
+    backend: ``"symbolic"`` or ``"python"`` user functions.
+    nodes: body name -> NodeIndex; ``markers``: body name (and ``"ground"``) -> MarkerIndex.
+    connectors: connector name -> ObjectIndex (``recoil_spring``, ``recoil_damper``, ``absorber_damper``,
+        ``contact``, ...); absent effects are absent keys.
+    user_function_connectors: names of the connectors driven by a user function.
+    sensors: name -> SensorIndex (``barrel_position`` ... ``absorber_acceleration``, ``contact_force``).
+    coordinates: body name -> index of its coordinate in the system's ODE2 coordinates.
+    """
+
+    scene: Scene
+    mechanism: Mechanism
+    system_container: Any
+    mbs: Any
+    backend: str
+    nodes: dict[str, Any] = field(default_factory=dict)
+    markers: dict[str, Any] = field(default_factory=dict)
+    connectors: dict[str, Any] = field(default_factory=dict)
+    user_function_connectors: list[str] = field(default_factory=list)
+    sensors: dict[str, Any] = field(default_factory=dict)
+    coordinates: dict[str, int] = field(default_factory=dict)
+
+    def close(self) -> None:
+        """Release the Exudyn model (needed for symbolic user functions to be freed)."""
+        if self.system_container is not None:
+            self.system_container.Reset()
+            self.system_container = None
+            self.mbs = None
+            for connector in self.mechanism.connectors:
+                connector.__dict__.pop("_user_function", None)
+
+    def __enter__(self) -> "Assembly":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+def add_body(mbs, mass: float, initial_velocity: float = 0.0):
+    """Add a 1-D body (m in kg, at x = 0 with ``initial_velocity`` m/s) to ``mbs``: (node, coordinate marker)."""
+    node = mbs.AddNode(NodeGenericODE2(referenceCoordinates=[0.0], initialCoordinates=[0.0],
+                                       initialCoordinates_t=[initial_velocity], numberOfODE2Coordinates=1))
+    mbs.AddObject(ObjectMass1D(nodeNumber=node, mass=mass))
+    marker = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=node, coordinate=0))
+    return node, marker
+
+
+def assemble(scene: Scene, user_functions: str = "symbolic", mechanism: Mechanism | None = None) -> Assembly:
+    """Build the Exudyn system of ``scene``; ``user_functions`` is ``"symbolic"`` or ``"python"``."""
+    if user_functions not in USER_FUNCTION_BACKENDS:
+        raise ValueError(f"user_functions must be 'symbolic' or 'python', got {user_functions!r}")
+    mechanism = Mechanism(scene) if mechanism is None else mechanism
+    system_container = exudyn.SystemContainer()
+    mbs = system_container.AddSystem()
+    assembly = Assembly(scene=scene, mechanism=mechanism, system_container=system_container, mbs=mbs,
+                        backend=user_functions)
+    ground = mbs.AddNode(NodePointGround())
+    assembly.markers[GROUND] = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=ground, coordinate=0))
+    for element in mechanism.elements:
+        for body in element.bodies:
+            node, marker = add_body(mbs, body.mass, body.initial_velocity)
+            assembly.nodes[body.name], assembly.markers[body.name] = node, marker
+            for quantity, ovt in (("position", _OVT.Coordinates), ("velocity", _OVT.Coordinates_t),
+                                  ("acceleration", _OVT.Coordinates_tt)):
+                assembly.sensors[f"{body.name}_{quantity}"] = mbs.AddSensor(
+                    SensorNode(nodeNumber=node, outputVariableType=ovt, storeInternal=True))
+        for connector in element.connectors:
+            index = connector.add_items(mbs, assembly.markers[connector.a], assembly.markers[connector.b],
+                                        user_functions)
+            assembly.connectors[connector.name] = index
+            if connector.needs_user_function:
+                assembly.user_function_connectors.append(connector.name)
+            if connector.records_force:
+                assembly.sensors[f"{connector.name}_force"] = mbs.AddSensor(
+                    SensorObject(objectNumber=index, outputVariableType=_OVT.Force, storeInternal=True))
+    mbs.Assemble()
+    data = mbs.systemData
+    assembly.coordinates = {name: data.GetNodeLTGODE2(node)[0] for name, node in assembly.nodes.items()}
+    velocities = {body.name: body.initial_velocity for body in mechanism.bodies}
+    for contact in mechanism.capturing_contacts:
+        contact.start(0.0, mechanism.relative(contact, velocities))
+    return assembly

@@ -1,0 +1,426 @@
+"""When is a metric final?  Energy bounds on everything a dissipative scene can still do.
+
+The sweeps and studies need peak metrics (Table 2's maximum barrel displacement, the peak contact
+force, the maximum absorber velocity, the peak force on the mount), which occur in the first second of
+a 10 s run.  This module proves, from the state at one instant, that no later instant can beat the
+maxima seen so far; the engine (:func:`mbs_models.simulate` with ``stop_when_final``) then stops there.
+
+Energy
+------
+The mechanical energy (J) is ``E = sum_i m_i v_i^2 / 2 + sum_c U_c(d_c)``: the kinetic energy of every
+body and the stored energy of every connector (springs ``k d^2 / 2``, contacts' elastic energy).  Its
+rate is minus the dissipated power of the connectors, which is >= 0 for every element: dampers
+``c d'^2``; every contact law ``(F - F_elastic) p' >= 0`` (damping during compression and restitution,
+and where the force is clipped to 0 the elastic part ``-F_elastic p'`` with ``p' < 0``).  So **E never
+increases** -- except under the paper's reading ``literal_lambda_sign``, which injects energy: then no
+bound holds and :func:`dissipative` is False (such scenes always run to their end time).
+
+Bounds (every term of E is >= 0, so each is <= E(t) at every later time)
+-----------------------------------------------------------------------
+* **Linear springs**: ``sum_c k_c (c.x)^2 <= 2E`` is a positive semi-definite quadratic form
+  ``x^T K x <= 2E`` (x: body positions).  The largest value of a linear combination ``g.x`` under it is
+  ``sqrt(2E g^T K^+ g)`` when g lies in the range of K (``K^+`` the pseudo-inverse), none otherwise.
+  For the paper's models: ``x_M <= sqrt(2E/k)``; ``x_M - x_m <= sqrt(2E/k_r)`` (absorber on the barrel)
+  or ``sqrt(2E (1/k + 1/k_r))`` (on the ground).
+* **Contacts**: a contact's own elastic energy bounds its penetration, ``p <= ((n+1) E / k)^(1/(n+1))``;
+  and ``p = d - offset <= (bound on d) - offset``: no contact is reachable once that is <= 0.  A recoil
+  stop bounds ``x_M <= position + p_max`` too.
+* **Velocities**: ``|v_i| <= sqrt(2E/m_i)``, ``|v_b - v_a| <= sqrt(2E (1/m_b + 1/m_a))``.  A body tied to
+  the ground by springs and dampers only, whose contacts are unreachable, is a free damped oscillator
+  whose own energy never increases: ``|v_i| <= sqrt(2 E_i / m_i)``.
+* **Forces**: each connector bounds its force from the bounds on d and d' (a spring ``k |d|``, a damper
+  ``c |d'|``, a contact ``k p^n (1 + lambda |p'|)``, with lambda = chi / minimum_impact_velocity for the
+  restitution laws); the force on the mount by the sum over the connectors touching the ground.
+
+Finality (what :class:`FinalityTracker` decides from the states it is shown)
+---------------------------------------------------------------------------
+* ``max_barrel_displacement`` (and its time): final once the x_M bound <= the largest x_M seen;
+* ``max_absorber_velocity``: once every absorber's velocity bound <= the largest velocity it had;
+* ``peak_contact_force``: once every contact (absorbers and stops) is unreachable or its force bound
+  <= the largest force it had;
+* ``impacts``: once every contact's force bound <= the impact threshold and no contact is going on;
+* ``peak_support_force``: once the bound on |S| <= the largest |S| seen.
+
+Ties keep the earliest time, as the peak refinement does.  The observed values are samples of the
+solution, hence lower bounds of its refined maxima: a metric proven final from samples is final.
+
+Numerical slack: a numerical solution dissipates energy only up to its integration error, so the
+bounds use ``E (1 + ENERGY_SLACK)``.  :func:`mbs_models.simulate` trusts an early stop only if the
+solution's energy rose by no more than that fraction anywhere in the simulated window
+(:func:`largest_energy_rise`), and otherwise re-solves to the end time.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Iterable
+
+import numpy as np
+
+from ..elements.connector import GROUND
+from ..errors import SceneError
+from ..results.result import ALL_METRICS
+from ..scene import Scene
+from .mechanism import Mechanism
+
+#: Metrics that can be proven final before the end time (names of :class:`~mbs_models.results.result.Result` fields).
+FINAL_METRICS = ALL_METRICS
+#: Relative margin on the energy in every bound: covers the integration error of the solution's
+#: energy (a relative rise of ~1e-9 per step at the presets' tolerances; see largest_energy_rise).
+ENERGY_SLACK = 1e-4
+#: Why a run ended (``Result.stop_reason``).
+STOP_END_TIME = "end_time"                  # reached the requested end time (no early stop asked, or not proven)
+STOP_METRICS_FINAL = "metrics_final"        # every metric named in stop_when_final was proven final
+STOP_NO_BOUND = "end_time_no_energy_bound"  # early stop asked, but the scene injects energy (literal_lambda_sign)
+STOP_ENERGY_CHECK = "end_time_energy_check"  # stopped early, but the energy error exceeded the slack: re-solved
+#: Eigenvalues of the stiffness form below this fraction of the largest count as zero.
+_RANK_TOLERANCE = 1e-12
+
+
+def check_metric_names(names, key: str = "stop_when_final") -> tuple[str, ...]:
+    """Validate a collection of metric names; return them as a tuple in :data:`FINAL_METRICS` order.
+
+    Raises SceneError naming ``key`` and the allowed values for a string (not a sequence of names),
+    an unknown name or a non-string item.
+    """
+    if isinstance(names, str):
+        raise SceneError(key, f"must be a sequence of metric names (e.g. ({names!r},)), not a string; "
+                              f"allowed: {', '.join(FINAL_METRICS)}")
+    try:
+        items = list(names)
+    except TypeError:
+        raise SceneError(key, f"must be a sequence of metric names; allowed: {', '.join(FINAL_METRICS)}") from None
+    for name in items:
+        if not isinstance(name, str) or name not in FINAL_METRICS:
+            raise SceneError(key, f"unknown metric {name!r}; allowed: {', '.join(FINAL_METRICS)}")
+    return tuple(name for name in FINAL_METRICS if name in items)
+
+
+def dissipative(scene: Scene) -> bool:
+    """True when the scene's mechanical energy never increases (every reading but literal_lambda_sign)."""
+    return not scene.conventions.literal_lambda_sign
+
+
+class _QuadraticForm:
+    """``x^T K x <= 2E`` of the linear springs: bound coefficients ``2 g^T K^+ g`` of linear combinations."""
+
+    def __init__(self, mechanism: Mechanism):
+        n = len(mechanism.bodies)
+        K = np.zeros((n, n))
+        for connector in mechanism.connectors:
+            k = connector.linear_stiffness
+            if k > 0:
+                g = mechanism.direction(connector)
+                K += k * np.outer(g, g)
+        values, vectors = np.linalg.eigh(K)
+        scale = max(float(np.max(np.abs(values))), 0.0) if n else 0.0
+        self._keep = values > _RANK_TOLERANCE * scale if scale > 0 else np.zeros(n, dtype=bool)
+        self._values, self._vectors = values, vectors
+
+    def coefficient(self, g: np.ndarray) -> float:
+        """``2 g^T K^+ g`` (so that ``|g.x| <= sqrt(coefficient E)``), or inf if g is not in K's range."""
+        components = self._vectors.T @ g
+        outside = components[~self._keep]
+        if outside.size and float(np.max(np.abs(outside))) > 1e-9 * max(float(np.max(np.abs(g))), 1.0):
+            return math.inf
+        inside = components[self._keep]
+        return 2.0 * float(np.sum(inside * inside / self._values[self._keep]))
+
+
+class EnergyBounds:
+    """The bounds of the module docstring for one scene, as functions of the energy ``E`` (J) now.
+
+    Every bound holds at *every later time* of a :func:`dissipative` scene (``math.inf`` where none
+    exists, e.g. along a direction without a spring).  States are body positions ``x`` and velocities
+    ``v`` in body order (m, m/s; plain sequences).  The scene's numbers are folded into a few
+    coefficients once, so that a call costs microseconds.
+    """
+
+    def __init__(self, scene: Scene | Mechanism):
+        mechanism = scene if isinstance(scene, Mechanism) else Mechanism(scene)
+        self.mechanism = mechanism
+        self.scene = mechanism.scene
+        form = _QuadraticForm(mechanism)
+        index = mechanism.body_index
+        self.masses = [b.mass for b in mechanism.bodies]
+        self._half_masses = [0.5 * m for m in self.masses]
+        # energy terms, grouped by element as they are summed (see energy())
+        self._groups = []
+        for element in mechanism.elements:
+            kinetic = [index[b.name] for b in element.bodies]
+            springs = [c for c in element.connectors if c.stores_energy and not c.is_contact]
+            contacts = [c for c in element.connectors if c.is_contact]
+            self._groups.append((kinetic, springs, contacts))
+        self._barrel_coefficient = form.coefficient(np.eye(len(self.masses))[0]) if self.masses else math.inf
+        self.contacts = mechanism.contacts
+        self._contact_coefficients = [form.coefficient(mechanism.direction(c)) for c in self.contacts]
+        self._rate_coefficients = [self._rate_coefficient(c) for c in self.contacts]
+        self._barrel_stops = [c for c in self.contacts if c.a == GROUND and c.b == mechanism.bodies[0].name]
+        ground = [c for c in mechanism.connectors if GROUND in (c.a, c.b)]
+        self._ground = [(c, form.coefficient(mechanism.direction(c)), self._rate_coefficient(c)) for c in ground]
+        self._free_oscillators = self._find_free_oscillators(mechanism)
+
+    def _rate_coefficient(self, connector) -> float:
+        """``2 (1/m_b + 1/m_a)`` (the ground's term left out): ``|d'| <= sqrt(coefficient E)``."""
+        m = self.mechanism
+        inverse = 0.0
+        for point in (connector.b, connector.a):
+            if point != GROUND:
+                inverse += 1.0 / m.bodies[m.body_index[point]].mass
+        return 2.0 * inverse
+
+    @staticmethod
+    def _find_free_oscillators(mechanism: Mechanism) -> dict[int, tuple[list, list]]:
+        """Bodies tied to the ground by linear connectors only (besides contacts): index -> (their
+        connectors, their contacts)."""
+        out = {}
+        for i, body in enumerate(mechanism.bodies):
+            touching = [c for c in mechanism.connectors if body.name in (c.a, c.b)]
+            contacts = [c for c in touching if c.is_contact]
+            others = [c for c in touching if not c.is_contact]
+            if i > 0 and all(GROUND in (c.a, c.b) for c in others):
+                out[i] = (others, contacts)
+        return out
+
+    # ---------------------------------------------------------------------------- the state
+    def energy(self, x, v) -> float:
+        """E in J at the state (body positions m, velocities m/s, in body order).
+
+        Summed element by element (an element's bodies and springs first, then its contacts).
+        """
+        energy = 0.0
+        mechanism = self.mechanism
+        half = self._half_masses
+        for kinetic, springs, contacts in self._groups:
+            if kinetic or springs:
+                part = None
+                for i in kinetic:
+                    term = half[i] * v[i] * v[i]
+                    part = term if part is None else part + term
+                for c in springs:
+                    d = mechanism.relative_at(c, x)
+                    term = 0.5 * c.stiffness * d * d
+                    part = term if part is None else part + term
+                energy += part
+            for c in contacts:
+                energy += c.python_elastic(mechanism.relative_at(c, x))
+        return energy
+
+    def contact_force(self, contact, x, v) -> float:
+        """The force (N) of a contact at the state, with its current onset rate."""
+        m = self.mechanism
+        return contact.python_force(m.relative_at(contact, x), m.relative_at(contact, v))
+
+    def support_force(self, x, v) -> float:
+        """The force on the mount (N, positive in the recoil direction) at the state."""
+        m = self.mechanism
+        total = 0.0
+        for c, _, _ in self._ground:
+            total += c.support_sign * c.python_force(m.relative_at(c, x), m.relative_at(c, v))
+        return total
+
+    def oscillator_energy(self, i: int, x, v) -> float:
+        """Energy (J) of body ``i`` with its ground connectors: its own, if it is a free oscillator."""
+        connectors, _ = self._free_oscillators[i]
+        m = self.mechanism
+        energy = self._half_masses[i] * v[i] * v[i]
+        for c in connectors:
+            if c.stores_energy:
+                d = m.relative_at(c, x)
+                energy += 0.5 * c.stiffness * d * d
+        return energy
+
+    # ---------------------------------------------------------------------------- bounds
+    def barrel_displacement(self, energy: float) -> float:
+        """Bound (m) on x_M: the springs' and every recoil stop's; inf without either."""
+        e = max(energy, 0.0)
+        bound = math.sqrt(self._barrel_coefficient * e)
+        for stop in self._barrel_stops:
+            bound = min(bound, stop.offset + stop.penetration_bound(e))
+        return bound
+
+    def body_velocity(self, i: int, energy: float) -> float:
+        """Bound (m/s) on |v_i|."""
+        return math.sqrt(2.0 / self.masses[i] * max(energy, 0.0))
+
+    def contact_reachable(self, j: int, energy: float) -> bool:
+        """Can contact ``j`` (index in :attr:`contacts`) close (p > 0) ever again?"""
+        return math.sqrt(self._contact_coefficients[j] * max(energy, 0.0)) > self.contacts[j].offset
+
+    def penetration(self, j: int, energy: float) -> float:
+        """Bound (m) on contact ``j``'s penetration (0 if it cannot close)."""
+        e = max(energy, 0.0)
+        relative = math.sqrt(self._contact_coefficients[j] * e)
+        contact = self.contacts[j]
+        if not relative > contact.offset:
+            return 0.0
+        return min(contact.penetration_bound(e), relative - contact.offset)
+
+    def penetration_rate(self, j: int, energy: float) -> float:
+        """Bound (m/s) on contact ``j``'s |p'|."""
+        return math.sqrt(self._rate_coefficients[j] * max(energy, 0.0))
+
+    def contact_force_bound(self, j: int, energy: float) -> float:
+        """Bound (N) on contact ``j``'s force (0 if it cannot close)."""
+        p = self.penetration(j, energy)
+        if p <= 0.0:
+            return 0.0
+        return self.contacts[j].force_bound(p, self.penetration_rate(j, energy), energy)
+
+    def support_force_bound(self, energy: float) -> float:
+        """Bound (N) on |S|: the sum of the force bounds of the connectors touching the ground."""
+        e = max(energy, 0.0)
+        total = 0.0
+        contact_index = {id(c): j for j, c in enumerate(self.contacts)}
+        for c, coefficient, rate_coefficient in self._ground:
+            if c.is_contact:
+                total += self.contact_force_bound(contact_index[id(c)], e)
+            else:
+                total += c.force_bound(math.sqrt(coefficient * e), math.sqrt(rate_coefficient * e), e)
+        return total
+
+
+def mechanical_energy(scene: Scene, x, v) -> float:
+    """E in J at a state of ``scene`` (body positions m, velocities m/s, in body order); see :class:`EnergyBounds`."""
+    return EnergyBounds(scene).energy(x, v)
+
+
+def largest_energy_rise(energy) -> float:
+    """Largest relative rise ``max_{i <= j} (E_j - E_i) / E_i`` of a sampled energy history (J).
+
+    0 for a non-increasing history; inf if the energy rises from exactly 0.  This is the assumption
+    behind every bound, checked on the simulated window.
+    """
+    e = np.asarray(energy, dtype=float)
+    if e.size < 2:
+        return 0.0
+    future_max = np.maximum.accumulate(e[::-1])[::-1]
+    rise = future_max - e
+    if np.any((rise > 0) & (e <= 0)):
+        return math.inf
+    with np.errstate(divide="ignore", invalid="ignore"):
+        relative = np.where(rise > 0, rise / np.where(e > 0, e, 1.0), 0.0)
+    return float(np.max(relative))
+
+
+class FinalityTracker:
+    """Watches the states of one solve and says which metrics are final (see the module docstring).
+
+    Show it the states in time order with :meth:`observe` (body positions m and velocities m/s in body
+    order); :attr:`final` holds the metrics proven final so far (once final, always final) and
+    :attr:`final_at` the time (s) each was proven.  ``requested`` are the metrics the caller wants;
+    :attr:`done` is True once all of them are final (never for a non-dissipative scene).  Metrics of
+    effects the scene lacks (contacts, absorbers) count as final from the start.
+    """
+
+    def __init__(self, scene: Scene | Mechanism, requested: Iterable[str], impact_threshold: float):
+        self.bounds = EnergyBounds(scene)
+        self.mechanism = self.bounds.mechanism
+        self.scene = self.mechanism.scene
+        self.requested = check_metric_names(requested)
+        self.impact_threshold = float(impact_threshold)
+        self.enabled = dissipative(self.scene)
+        self.max_barrel_position = -math.inf
+        self.max_velocity = [-math.inf] * len(self.mechanism.bodies)
+        self.max_contact_force = [0.0] * len(self.bounds.contacts)
+        self.max_support_force = 0.0
+        self.final: set[str] = set()
+        self.final_at: dict[str, float] = {}
+        self.done = False
+        self._absorbers = list(range(1, len(self.mechanism.bodies)))
+        self._needs_support = "peak_support_force" in self.requested
+        self._needs_contacts = any(n in self.requested for n in ("peak_contact_force", "impacts"))
+        empty = []
+        if not self.bounds.contacts:
+            empty += ["peak_contact_force", "impacts"]
+        if not self._absorbers:
+            empty.append("max_absorber_velocity")
+        self._mark(empty, 0.0)
+
+    @property
+    def max_absorber_velocity(self) -> float:
+        """The largest absorber velocity seen (m/s), over all absorbers."""
+        return max((self.max_velocity[i] for i in self._absorbers), default=-math.inf)
+
+    def _mark(self, names: Iterable[str], t: float) -> None:
+        for name in names:
+            if name not in self.final:
+                self.final.add(name)
+                self.final_at[name] = float(t)
+        self.done = self.enabled and bool(self.requested) and all(name in self.final for name in self.requested)
+
+    def observe(self, t: float, x, v, *, support: bool | None = None) -> bool:
+        """Take the state at time ``t`` (s) into account; return :attr:`done`.
+
+        The state updates the running maxima (samples of the solution: lower bounds of its maxima,
+        so observing only some states is safe, it merely proves finality a little later), then the
+        bounds of the requested metrics are evaluated at it.
+        """
+        if x[0] > self.max_barrel_position:
+            self.max_barrel_position = x[0]
+        for i in self._absorbers:
+            if v[i] > self.max_velocity[i]:
+                self.max_velocity[i] = v[i]
+        forces = []
+        for j, contact in enumerate(self.bounds.contacts):
+            force = self.bounds.contact_force(contact, x, v)
+            forces.append(force)
+            if force > self.max_contact_force[j]:
+                self.max_contact_force[j] = force
+        if self._needs_support if support is None else support:
+            magnitude = abs(self.bounds.support_force(x, v))
+            if magnitude > self.max_support_force:
+                self.max_support_force = magnitude
+        if self.enabled:
+            self.check(t, x, v, forces, self.requested)
+        return self.done
+
+    def check(self, t: float, x, v, forces, names: Iterable[str] = FINAL_METRICS) -> None:
+        """Mark those of ``names`` that the energy at this state (contact forces ``forces`` N, in
+        :attr:`EnergyBounds.contacts` order) proves final."""
+        if not self.enabled:
+            return
+        todo = [name for name in names if name not in self.final]
+        if not todo:
+            return
+        bounds = self.bounds
+        energy = bounds.energy(x, v) * (1.0 + ENERGY_SLACK)
+        newly = []
+        if "max_barrel_displacement" in todo and bounds.barrel_displacement(energy) <= self.max_barrel_position:
+            newly.append("max_barrel_displacement")
+        # the contact metrics are decided together (as they are cheap together): all of them as soon as
+        # any is pending
+        if any(name in todo for name in ("peak_contact_force", "impacts", "max_absorber_velocity")):
+            todo += [n for n in ("peak_contact_force", "impacts", "max_absorber_velocity")
+                     if n not in self.final and n not in todo]
+        reachable = [bounds.contact_reachable(j, energy) for j in range(len(bounds.contacts))]
+        if "peak_contact_force" in todo or "impacts" in todo:
+            force_bounds = [bounds.contact_force_bound(j, energy) for j in range(len(bounds.contacts))]
+            if all(not reachable[j] or force_bounds[j] <= self.max_contact_force[j] for j in range(len(reachable))):
+                newly.append("peak_contact_force")
+            if all(fb <= self.impact_threshold for fb in force_bounds) and all(f == 0.0 for f in forces):
+                newly.append("impacts")
+        if "max_absorber_velocity" in todo:
+            final = True
+            for i in self._absorbers:
+                bound = bounds.body_velocity(i, energy)
+                if i in bounds._free_oscillators:
+                    _, contacts = bounds._free_oscillators[i]
+                    if not any(reachable[bounds.contacts.index(c)] for c in contacts):
+                        own = bounds.oscillator_energy(i, x, v) * (1.0 + ENERGY_SLACK)
+                        bound = min(bound, bounds.body_velocity(i, own))
+                if bound > self.max_velocity[i]:
+                    final = False
+                    break
+            if final:
+                newly.append("max_absorber_velocity")
+        if "peak_support_force" in todo and bounds.support_force_bound(energy) <= self.max_support_force:
+            newly.append("peak_support_force")
+        if newly:
+            self._mark(newly, t)
+
+    def observe_last(self, t: float, x, v) -> None:
+        """Observe the final state of a solve and check *every* metric there (not only the requested ones)."""
+        self.observe(t, x, v, support=True)
+        forces = [self.bounds.contact_force(c, x, v) for c in self.bounds.contacts]
+        self.check(t, x, v, forces, FINAL_METRICS)

@@ -1,0 +1,123 @@
+"""The scene as bodies and connectors: what assembly, post-processing, the early stop and the checks iterate over.
+
+:class:`Mechanism` asks every element of a scene (in the scene's order) for its bodies and connectors
+(:mod:`mbs_models.elements`) and offers the few generic views the engine needs: body indices, the
+contacts, relative coordinates of a connector from body values, the support force.  It needs no
+Exudyn; a new one is built for every solve (contact connectors carry the onset capture of one solve).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..elements.barrel import BARREL
+from ..elements.connector import GROUND, Body, Connector
+from ..scene import Scene
+
+
+@dataclass
+class ElementParts:
+    """One element of the scene: its name, table, and the bodies and connectors it adds."""
+
+    name: str
+    table: object
+    bodies: list[Body] = field(default_factory=list)
+    connectors: list[Connector] = field(default_factory=list)
+
+
+class Mechanism:
+    """Bodies and connectors of one scene, in assembly order (the barrel first).
+
+    Attributes
+    ----------
+    scene: the scene.
+    elements: :class:`ElementParts` per element, in the scene's order.
+    bodies: every body (the barrel first); ``body_index[name]`` its position.
+    connectors: every connector, in element order; ``connector[name]`` by name.
+    """
+
+    def __init__(self, scene: Scene):
+        self.scene = scene
+        self.elements: list[ElementParts] = []
+        for name, table in scene.elements():
+            self.elements.append(ElementParts(name, table, table.bodies(scene, name), table.connectors(scene, name)))
+        self.bodies: list[Body] = [b for e in self.elements for b in e.bodies]
+        self.connectors: list[Connector] = [c for e in self.elements for c in e.connectors]
+        self.body_index = {body.name: i for i, body in enumerate(self.bodies)}
+        self.connector = {c.name: c for c in self.connectors}
+        if not self.bodies or self.bodies[0].name != BARREL:
+            raise ValueError("the barrel must be the first body")
+
+    # ------------------------------------------------------------------ views
+    @property
+    def contacts(self) -> list[Connector]:
+        """Every contact connector (absorbers' contacts and stops)."""
+        return [c for c in self.connectors if c.is_contact]
+
+    @property
+    def absorber_contacts(self) -> list[Connector]:
+        """Contacts between two bodies (wall A against an absorber): the version-1 contact metrics."""
+        return [c for c in self.contacts if GROUND not in (c.a, c.b)]
+
+    @property
+    def stop_contacts(self) -> list[Connector]:
+        """Contacts between a body and the ground (the end stops)."""
+        return [c for c in self.contacts if GROUND in (c.a, c.b)]
+
+    @property
+    def absorber_bodies(self) -> list[Body]:
+        """Every body but the barrel (the absorbers)."""
+        return self.bodies[1:]
+
+    @property
+    def capturing_contacts(self) -> list[Connector]:
+        """Contacts whose law needs the onset rate v- (restitution laws)."""
+        return [c for c in self.contacts if getattr(c, "capture", None) is not None]
+
+    @property
+    def masses(self) -> np.ndarray:
+        """Body masses (kg) in body order."""
+        return np.array([b.mass for b in self.bodies])
+
+    def initial_velocities(self) -> list[float]:
+        """Body velocities (m/s) at t = 0, in body order."""
+        return [b.initial_velocity for b in self.bodies]
+
+    # ------------------------------------------------------------------ connector kinematics
+    @staticmethod
+    def relative(connector: Connector, values: dict):
+        """``value_b - value_a`` of a connector from per-body values (the ground's are 0): d or d'."""
+        if connector.a == GROUND:
+            return values[connector.b]
+        if connector.b == GROUND:
+            return -values[connector.a]
+        return values[connector.b] - values[connector.a]
+
+    def relative_at(self, connector: Connector, vector) -> float:
+        """``d`` (or ``d'``) of a connector from a vector of body values in body order (plain floats)."""
+        a = 0.0 if connector.a == GROUND else vector[self.body_index[connector.a]]
+        b = 0.0 if connector.b == GROUND else vector[self.body_index[connector.b]]
+        return b - a
+
+    def direction(self, connector: Connector) -> np.ndarray:
+        """The vector c with ``d = c . x`` (x: body positions in body order)."""
+        c = np.zeros(len(self.bodies))
+        if connector.b != GROUND:
+            c[self.body_index[connector.b]] += 1.0
+        if connector.a != GROUND:
+            c[self.body_index[connector.a]] -= 1.0
+        return c
+
+    def initial_stored_energy(self) -> float:
+        """Stored energy (J) at t = 0 (all bodies at x = 0): a contact's initial interference."""
+        energy = 0.0
+        for connector in self.connectors:
+            if connector.stores_energy:
+                energy += float(connector.stored_energy(0.0))
+        return energy
+
+    def initial_energy(self) -> float:
+        """Mechanical energy at t = 0 in J: kinetic + stored (an initial interference)."""
+        return self.scene.initial_kinetic_energy + self.initial_stored_energy()

@@ -1,0 +1,316 @@
+"""What a simulation returns: :class:`Result` (time histories + metrics), :class:`Impact`, :class:`ContactOutput`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..elements.barrel import BARREL
+
+#: Every metric a run can report (and prove final with ``stop_when_final``).
+ALL_METRICS = ("max_barrel_displacement", "peak_contact_force", "max_absorber_velocity", "impacts",
+               "peak_support_force")
+
+
+@dataclass(frozen=True)
+class Impact:
+    """One contact episode whose peak force exceeds the threshold.
+
+    Attributes: ``start`` and ``end`` (s) bound the interval where the contact force is > 0;
+    ``peak_force`` (N) is its maximum, reached at ``time_of_peak_force`` (s); ``contact`` names the
+    contact (``"contact"`` for the one absorber's, ``"front_contact"``, ``"recoil_stop"``).
+    """
+
+    start: float
+    end: float
+    peak_force: float
+    time_of_peak_force: float
+    contact: str = "contact"
+
+    @property
+    def duration(self) -> float:
+        """Contact duration in s."""
+        return self.end - self.start
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"start": self.start, "end": self.end, "peak_force": self.peak_force,
+                "time_of_peak_force": self.time_of_peak_force, "contact": self.contact}
+
+
+@dataclass
+class ContactOutput:
+    """One contact of a run: its force history (N, at the output times), refined peak and impacts.
+
+    ``element`` is the element it belongs to (the absorber's name, ``recoil_stop``...); ``episodes`` the
+    number of contact episodes (force > 0), ``impacts`` those above the threshold; ``onsets``: for laws
+    that use it, ``(time s, v- m/s)`` at the onset of each episode as captured in the solve.
+    ``peak_force``/``impacts`` are None when an early-stopped run did not prove them final.
+    """
+
+    name: str
+    element: str
+    force: np.ndarray = field(repr=False)
+    peak_force: float | None
+    time_of_peak_force: float | None
+    impacts: list[Impact] | None
+    episodes: int = 0
+    onsets: list[tuple[float, float]] | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"name": self.name, "element": self.element, "peak_contact_force": self.peak_force,
+                "time_of_peak_contact_force": self.time_of_peak_force,
+                "impacts": None if self.impacts is None else [i.to_dict() for i in self.impacts]}
+
+
+@dataclass
+class Result:
+    """Time histories (numpy arrays at the solver's output steps, SI units) and metrics of one run.
+
+    Histories: ``time`` (s); ``positions``, ``velocities``, ``accelerations`` per body name (m, m/s,
+    m/s^2; ``"barrel"`` and the absorbers); ``contacts`` per contact name (:class:`ContactOutput`, force
+    history and metrics); ``support_force`` (N): the force on the mount, positive in the recoil direction.
+    Version-1 shortcuts: ``barrel_position`` ... ``barrel_acceleration``; ``absorber_position`` ...,
+    ``contact_force`` for a scene with one absorber (None without -- never zeros -- and with several:
+    use the dictionaries).
+
+    Metrics (refined between output samples, see :mod:`mbs_models.results.peaks`):
+    ``max_barrel_displacement`` (m, Table 2) and its time; ``peak_support_force`` (largest |S|, N) and its
+    time; ``peak_contact_force`` (N) and ``max_absorber_velocity`` (m/s), the largest over all absorbers,
+    with their times; ``impacts`` (all absorbers' impacts in time order); ``dissipated_energy`` (J per
+    dissipating connector at the end time); :meth:`absorbers`, :meth:`stops`, :meth:`energy` per element.
+
+    Window: the histories cover ``[0, end_time]`` s.  ``requested_end_time`` is what was asked for;
+    ``end_time`` is smaller only when ``simulate(..., stop_when_final=...)`` stopped the solve because
+    the named metrics were proven final (``stop_reason == "metrics_final"``, see
+    :mod:`mbs_models.engine.final_metrics`).  ``final_metrics`` names the metrics whose values are those
+    of a run to ``requested_end_time``; every other metric (with its time) is None -- ``impacts`` too.
+    """
+
+    scene: Any
+    settings: Any
+    end_time: float
+    time: np.ndarray
+    positions: dict[str, np.ndarray] = field(repr=False)
+    velocities: dict[str, np.ndarray] = field(repr=False)
+    accelerations: dict[str, np.ndarray] = field(repr=False)
+    contacts: dict[str, ContactOutput] = field(repr=False)
+    support_force: np.ndarray = field(repr=False)
+    max_barrel_displacement: float | None
+    time_of_max_barrel_displacement: float | None
+    peak_contact_force: float | None
+    time_of_peak_contact_force: float | None
+    max_absorber_velocity: float | None
+    time_of_max_absorber_velocity: float | None
+    impacts: list[Impact] | None
+    impact_threshold: float
+    dissipated_energy: dict[str, float]
+    peak_support_force: float | None = None
+    time_of_peak_support_force: float | None = None
+    max_velocities: dict[str, tuple[float | None, float | None]] = field(default_factory=dict)
+    dissipated_energy_history: dict[str, np.ndarray] = field(repr=False, default_factory=dict)
+    stored_energy_histories: dict[str, np.ndarray] = field(repr=False, default_factory=dict)
+    kinetic_energy_histories: dict[str, np.ndarray] = field(repr=False, default_factory=dict)
+    element_of: dict[str, str] = field(repr=False, default_factory=dict)
+    wall_time: float = 0.0
+    timings: dict[str, float] = field(default_factory=dict)
+    steps: int = 0
+    requested_end_time: float | None = None
+    stop_reason: str = "end_time"
+    final_metrics: tuple[str, ...] = ALL_METRICS
+
+    def __post_init__(self):
+        if self.requested_end_time is None:
+            self.requested_end_time = self.end_time
+
+    # ------------------------------------------------------------------ version-1 shortcuts
+    @property
+    def barrel_position(self) -> np.ndarray:
+        """x_M (m)."""
+        return self.positions[BARREL]
+
+    @property
+    def barrel_velocity(self) -> np.ndarray:
+        return self.velocities[BARREL]
+
+    @property
+    def barrel_acceleration(self) -> np.ndarray:
+        return self.accelerations[BARREL]
+
+    def _single_absorber(self) -> str | None:
+        names = [name for name in self.positions if name != BARREL]
+        return names[0] if len(names) == 1 else None
+
+    @property
+    def absorber_names(self) -> list[str]:
+        """The absorbers' (bodies') names."""
+        return [name for name in self.positions if name != BARREL]
+
+    @property
+    def absorber_position(self) -> np.ndarray | None:
+        """x_m (m) of the one absorber (None without, or with several)."""
+        name = self._single_absorber()
+        return None if name is None else self.positions[name]
+
+    @property
+    def absorber_velocity(self) -> np.ndarray | None:
+        name = self._single_absorber()
+        return None if name is None else self.velocities[name]
+
+    @property
+    def absorber_acceleration(self) -> np.ndarray | None:
+        name = self._single_absorber()
+        return None if name is None else self.accelerations[name]
+
+    @property
+    def contact_force(self) -> np.ndarray | None:
+        """F (N, >= 0) of the one absorber's contact (None without, or with several)."""
+        output = self.contacts.get("contact")
+        return None if output is None else output.force
+
+    @property
+    def kinetic_energy_history(self) -> np.ndarray:
+        """Kinetic energy of all bodies (J) at the output times."""
+        return _sum(self.kinetic_energy_histories.values(), self.time)
+
+    @property
+    def stored_energy_history(self) -> np.ndarray:
+        """Energy stored in all springs and contacts (J) at the output times."""
+        return _sum(self.stored_energy_histories.values(), self.time)
+
+    # ------------------------------------------------------------------ energy
+    @property
+    def total_dissipated_energy(self) -> float:
+        """Energy dissipated by all dampers and contacts up to the end time, in J."""
+        return float(sum(self.dissipated_energy.values()))
+
+    def energy_error(self) -> np.ndarray:
+        """Energy balance residual over time, in J: kinetic + stored + dissipated - initial energy.
+
+        The initial energy is the kinetic energy at t = 0 plus the stored energy of an initial
+        interference.  Zero for an exact solution; its size measures the integration (and quadrature) error.
+        """
+        dissipated = sum(self.dissipated_energy_history.values())
+        initial = self.kinetic_energy_history[0] + self.stored_energy_history[0]
+        return self.kinetic_energy_history + self.stored_energy_history + dissipated - initial
+
+    def energy(self) -> dict[str, dict[str, float]]:
+        """Per element at the end time, J: ``{element: {"kinetic": ..., "stored": ..., "dissipated": ...}}``.
+
+        Their sum over elements and kinds is the initial energy (up to :meth:`energy_error`).
+        """
+        out: dict[str, dict[str, float]] = {}
+        for kind, histories in (("kinetic", self.kinetic_energy_histories), ("stored", self.stored_energy_histories),
+                                ("dissipated", self.dissipated_energy_history)):
+            for name, history in histories.items():
+                element = self.element_of.get(name, name)
+                entry = out.setdefault(element, {"kinetic": 0.0, "stored": 0.0, "dissipated": 0.0})
+                entry[kind] += float(history[-1])
+        return out
+
+    # ------------------------------------------------------------------ per element
+    def absorbers(self) -> list[dict[str, Any]]:
+        """Per absorber: ``name``, ``peak_contact_force`` (N) and time, ``max_absorber_velocity`` (m/s) and
+        time, ``impacts`` (its contact's)."""
+        out = []
+        for name in self.absorber_names:
+            contact = next((c for c in self.contacts.values() if c.element == name), None)
+            v_max, t_v = self.max_velocities.get(name, (None, None))
+            out.append({"name": name,
+                        "peak_contact_force": None if contact is None else contact.peak_force,
+                        "time_of_peak_contact_force": None if contact is None else contact.time_of_peak_force,
+                        "max_absorber_velocity": v_max, "time_of_max_absorber_velocity": t_v,
+                        "impacts": None if contact is None or contact.impacts is None else
+                        [i.to_dict() for i in contact.impacts]})
+        return out
+
+    def stops(self) -> list[dict[str, Any]]:
+        """Per end stop: ``name``, ``peak_contact_force`` (N) and time, ``impacts``, ``dissipated_energy`` (J)."""
+        out = []
+        for contact in self.contacts.values():
+            if contact.element in self.absorber_names:
+                continue
+            entry = contact.to_dict()
+            entry["dissipated_energy"] = self.dissipated_energy.get(contact.name)
+            out.append(entry)
+        return out
+
+    # ------------------------------------------------------------------ reports
+    def metrics(self) -> dict[str, Any]:
+        """The scalar results as a JSON-ready dict (the keys of ``recoil run --json``)."""
+        return {
+            "scene": self.scene.name,
+            "model": self.scene.model_label,
+            "initial_velocity": self.scene.initial_velocity,
+            "end_time": self.end_time,
+            "requested_end_time": self.requested_end_time,
+            "stop_reason": self.stop_reason,
+            "final_metrics": list(self.final_metrics),
+            "solver": self.settings.label(),
+            "max_barrel_displacement": self.max_barrel_displacement,
+            "time_of_max_barrel_displacement": self.time_of_max_barrel_displacement,
+            "peak_support_force": self.peak_support_force,
+            "time_of_peak_support_force": self.time_of_peak_support_force,
+            "peak_contact_force": self.peak_contact_force,
+            "time_of_peak_contact_force": self.time_of_peak_contact_force,
+            "max_absorber_velocity": self.max_absorber_velocity,
+            "time_of_max_absorber_velocity": self.time_of_max_absorber_velocity,
+            "impact_threshold": self.impact_threshold,
+            "impacts": None if self.impacts is None else [impact.to_dict() for impact in self.impacts],
+            "absorbers": self.absorbers(),
+            "stops": self.stops(),
+            "dissipated_energy": dict(self.dissipated_energy),
+            "energy": self.energy(),
+            "steps": self.steps,
+            "wall_time": self.wall_time,
+        }
+
+    def summary(self) -> str:
+        """A few human-readable lines."""
+        window = f"{self.end_time:g} s"
+        if self.stop_reason != "end_time":
+            window += f" of {self.requested_end_time:g} s requested ({self.stop_reason.replace('_', ' ')})"
+        lines = [f"{self.scene.name} ({self.scene.model_label}), {window}, {self.settings.label()}"]
+        not_final = "not proven final (run stopped early)"
+        if self.max_barrel_displacement is not None:
+            lines.append(f"  max barrel displacement  {self.max_barrel_displacement:.6f} m at "
+                         f"{self.time_of_max_barrel_displacement:.5f} s")
+        else:
+            lines.append(f"  max barrel displacement  {not_final}")
+        if self.peak_support_force is not None:
+            lines.append(f"  peak support force       {self.peak_support_force / 1e3:.3f} kN at "
+                         f"{self.time_of_peak_support_force:.5f} s")
+        else:
+            lines.append(f"  peak support force       {not_final}")
+        if self.scene.has_absorber:
+            if self.peak_contact_force is None:
+                lines.append(f"  peak contact force       {not_final}")
+            elif self.time_of_peak_contact_force is None:
+                lines.append("  peak contact force       0 (no contact)")
+            else:
+                lines.append(f"  peak contact force       {self.peak_contact_force / 1e3:.3f} kN at "
+                             f"{self.time_of_peak_contact_force:.5f} s")
+            if self.max_absorber_velocity is None:
+                lines.append(f"  max absorber velocity    {not_final}")
+            else:
+                lines.append(f"  max absorber velocity    {self.max_absorber_velocity:.5f} m/s at "
+                             f"{self.time_of_max_absorber_velocity:.5f} s")
+            impacts = not_final if self.impacts is None else len(self.impacts)
+            lines.append(f"  impacts (> {self.impact_threshold / 1e3:g} kN)      {impacts}")
+        for stop in self.stops():
+            peak = stop["peak_contact_force"]
+            text = not_final if peak is None else (f"{peak / 1e3:.3f} kN" + (
+                f", {len(stop['impacts'])} impacts" if stop["impacts"] is not None else ""))
+            lines.append(f"  {stop['name'].replace('_', ' '):24s} {text}")
+        lines.append(f"  energy dissipated        {self.total_dissipated_energy:.2f} J of "
+                     f"{self.kinetic_energy_history[0] + self.stored_energy_history[0]:.2f} J")
+        lines.append(f"  wall time                {self.wall_time * 1e3:.1f} ms ({self.steps} steps)")
+        return "\n".join(lines)
+
+
+def _sum(arrays, like) -> np.ndarray:
+    total = None
+    for array in arrays:
+        total = array if total is None else total + array
+    return np.zeros_like(like) if total is None else total
