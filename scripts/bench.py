@@ -56,7 +56,7 @@ def ms(seconds: float) -> str:
 def import_cost() -> dict[str, float]:
     """Import times (s) in a fresh interpreter: exudyn alone, and everything a run needs."""
     code = ("import time; t0 = time.perf_counter(); import numpy; t1 = time.perf_counter(); import exudyn; "
-            "t2 = time.perf_counter(); import mbs_models.simulation; t3 = time.perf_counter(); "
+            "t2 = time.perf_counter(); import mbs_models.engine.simulation; t3 = time.perf_counter(); "
             "print(t1 - t0, t2 - t1, t3 - t2)")
     runs = []
     for _ in range(3):
@@ -64,7 +64,7 @@ def import_cost() -> dict[str, float]:
                              env={**os.environ, "PYTHONPATH": str(ROOT)}, check=True).stdout.split()
         runs.append([float(x) for x in out])
     numpy_t, exudyn_t, rest_t = (statistics.median(r[i] for r in runs) for i in range(3))
-    return {"numpy": numpy_t, "exudyn": exudyn_t, "mbs_models.simulation and what it imports": rest_t}
+    return {"numpy": numpy_t, "exudyn": exudyn_t, "mbs_models.engine.simulation and what it imports": rest_t}
 
 
 # ------------------------------------------------------------------------------------------------ breakdown
@@ -74,11 +74,11 @@ def breakdown_round(scene, end_time: float, stages: dict[str, list[float]]) -> N
     import importlib
 
     from mbs_models import stability
-    from mbs_models.accuracy import solver_settings_for
-    from mbs_models.assembly import assemble
-    from mbs_models.postprocess import _Interpolant, analyse, energies, find_impacts
+    from mbs_models.engine.accuracy import solver_settings_for
+    from mbs_models.engine.assembly import assemble
+    from mbs_models.results.postprocess import _Interpolant, analyse, energies, find_impacts
 
-    engine = importlib.import_module("mbs_models.simulation")
+    engine = importlib.import_module("mbs_models.engine.simulation")
     settings = solver_settings_for("standard")
 
     def timed(name, function, *args):
@@ -153,7 +153,7 @@ class CompiledDopri5:
         return run
 
     def samples(self, count: int):
-        from mbs_models.postprocess import Samples
+        from mbs_models.results.postprocess import Samples
 
         y, f = self.y[:count], self.f[:count]
         return Samples(time=self.t[:count].copy(), barrel_position=y[:, 0].copy(), barrel_velocity=y[:, 1].copy(),
@@ -207,7 +207,7 @@ def main(argv=None) -> int:
     warnings.simplefilter("ignore")
     from mbs_models.cli import _resolve_scene
     from mbs_models import simulate
-    from mbs_models.accuracy import ACCURACY_PRESETS
+    from mbs_models.engine.accuracy import ACCURACY_PRESETS
     from validation.studies.precision import (PRESET_METRICS, RunValues, _engine_values, compute_truth, relative_errors,
                                       solve_plain)
 
@@ -254,8 +254,8 @@ def main(argv=None) -> int:
         compiled_run = yardstick.prepare(scene, end_time, standard.relative_tolerance, standard.absolute_tolerance,
                                          standard.max_step)
         count = compiled_run()
-        from mbs_models.peaks import HermiteTrajectory
-        from mbs_models.postprocess import analyse
+        from mbs_models.results.peaks import HermiteTrajectory
+        from mbs_models.results.postprocess import analyse
         from validation.reference.equations import Parameters
         from validation.studies.precision import plain_contact_force
 

@@ -152,7 +152,7 @@ def test_the_bounds_bound_the_future_of_the_dense_solution(key):
                                    model_i(1000.0, 0.08).with_changes(**{"contact.exponent": 1.0}),
                                    simplified_model()], ids=["i", "ii", "ii-literal-gap", "i-linear", "simplified"])
 def test_the_two_independent_implementations_agree(scene):
-    from mbs_models.final_metrics import EnergyBounds
+    from mbs_models.engine.final_metrics import EnergyBounds
 
     engine = EnergyBounds(scene)
     P = eq.Parameters.from_scene(scene)
@@ -179,7 +179,7 @@ def test_the_two_independent_implementations_agree(scene):
 def test_validation_still_imports_no_engine_code():
     code = ("import sys, validation.reference, validation.reference.finality\n"
             "bad = [m for m in sys.modules if m == 'exudyn' or m.startswith('exudyn.') or m in "
-            "('mbs_models.simulation', 'mbs_models.final_metrics', 'mbs_models.forces', 'mbs_models.result')]\n"
+            "('mbs_models.engine.simulation', 'mbs_models.engine.final_metrics', 'mbs_models.forces', 'mbs_models.results.result')]\n"
             "print(bad)\nsys.exit(1 if bad else 0)\n")
     env = dict(os.environ, PYTHONPATH=str(REPO) + os.pathsep + os.environ.get("PYTHONPATH", ""))
     out = subprocess.run([sys.executable, "-c", code], cwd=REPO, env=env, capture_output=True, text=True, timeout=60)

@@ -269,8 +269,8 @@ def test_bad_arguments():
 def test_import_does_not_load_exudyn_or_engine():
     code = ("import sys, validation, validation.reference, validation.reference.closed_form, validation.studies.paper\n"
             "bad = [m for m in sys.modules if m == 'exudyn' or m.startswith('exudyn.') or m in "
-            "('mbs_models.simulation', 'mbs_models.assembly', 'mbs_models.forces', 'mbs_models.result', "
-            "'mbs_models.peaks', 'mbs_models.accuracy', 'mbs_models.cli')]\n"
+            "('mbs_models.engine.simulation', 'mbs_models.engine.assembly', 'mbs_models.forces', 'mbs_models.results.result', "
+            "'mbs_models.results.peaks', 'mbs_models.engine.accuracy', 'mbs_models.cli')]\n"
             "print(bad)\n"
             "sys.exit(1 if bad else 0)\n")
     env = dict(os.environ, PYTHONPATH=str(REPO) + os.pathsep + os.environ.get("PYTHONPATH", ""))

@@ -243,6 +243,10 @@ class EnergyBounds:
         """Bound (m/s) on |v_i|."""
         return math.sqrt(2.0 / self.masses[i] * max(energy, 0.0))
 
+    def contact_coordinate(self, j: int, energy: float) -> float:
+        """Bound (m) on contact ``j``'s relative coordinate d (= x_M - x_m for an absorber) from the springs."""
+        return math.sqrt(self._contact_coefficients[j] * max(energy, 0.0))
+
     def contact_reachable(self, j: int, energy: float) -> bool:
         """Can contact ``j`` (index in :attr:`contacts`) close (p > 0) ever again?"""
         return math.sqrt(self._contact_coefficients[j] * max(energy, 0.0)) > self.contacts[j].offset

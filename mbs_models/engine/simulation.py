@@ -4,8 +4,8 @@ Contract
 --------
 * The scene is assembled with only the items its elements call for (:mod:`mbs_models.engine.assembly`).
 * ``accuracy`` is a preset name (``"draft"``, ``"standard"`` default, ``"reference"``) or explicit
-  :class:`~mbs_models.accuracy.SolverSettings`.
-* The return value is a complete :class:`~mbs_models.result.Result`, or a
+  :class:`~mbs_models.engine.accuracy.SolverSettings`.
+* The return value is a complete :class:`~mbs_models.results.result.Result`, or a
   :class:`~mbs_models.errors.SimulationError` is raised: a solver that fails, stops before
   ``end_time``, or produces NaN/inf never yields a result.  The one exception is asked for:
   ``stop_when_final`` stops the solve once energy bounds prove the named metrics final
@@ -309,10 +309,10 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
     accuracy: ``"draft"``, ``"standard"`` (default) or ``"reference"``, or a :class:`SolverSettings`.
     user_functions: override the settings' backend: ``"symbolic"`` (C++) or ``"python"``.
     impact_threshold: a contact episode counts as an impact when its peak force exceeds this (N).
-    stop_when_final: metric names among :data:`~mbs_models.final_metrics.FINAL_METRICS`
+    stop_when_final: metric names among :data:`~mbs_models.engine.final_metrics.FINAL_METRICS`
         (``"max_barrel_displacement"``, ``"peak_contact_force"``, ``"max_absorber_velocity"``,
         ``"impacts"``).  The solve stops as soon as energy bounds prove that none of them can change
-        before ``end_time`` (:mod:`mbs_models.final_metrics`); the result then covers
+        before ``end_time`` (:mod:`mbs_models.engine.final_metrics`); the result then covers
         ``[0, result.end_time]`` with ``result.requested_end_time`` = ``end_time``,
         ``result.stop_reason == "metrics_final"``, and every metric *not* proven final at the stop
         (with its time) is None (``impacts`` too), never a value of the shorter window.  Scenes that
@@ -326,7 +326,7 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
     SceneError: an argument is invalid, or a fixed step is unsafe for the scene (the message names it
         and gives the safe limit).
     SimulationError: the solve failed, stopped early, produced non-finite values, stepped over a
-        contact with a fixed step, or does not balance energy (see :mod:`mbs_models.stability`).
+        contact with a fixed step, or does not balance energy (see :mod:`mbs_models.engine.stability`).
 
     Warns
     -----

@@ -4,7 +4,7 @@ Exudyn models cannot be pickled, so workers receive *scenes* (frozen dataclasses
 the scalar metrics of each run (:class:`SweepPoint`), never models or arrays.
 
     from mbs_models import model_i
-    from mbs_models.sweep import gap_sweep
+    from mbs_models.studies.sweep import gap_sweep
     points = gap_sweep(model_i, absorber_mass=500.0, gaps=[0.0, 0.01, 0.02])
 """
 
@@ -32,7 +32,7 @@ class SweepPoint:
 
     With ``stop_when_final`` a run may end before the requested end time (``end_time`` is the
     simulated one, ``stop_reason`` says why); a metric not proven final is None, as in
-    :class:`~mbs_models.result.Result`.  ``impacts`` is the number of impacts.
+    :class:`~mbs_models.results.result.Result`.  ``impacts`` is the number of impacts.
     """
 
     scene: Scene

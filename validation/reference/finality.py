@@ -1,7 +1,7 @@
 """Energy bounds that tell the reference solver when a peak metric can no longer change.
 
 Written from the equations of :mod:`validation.reference.equations`, independently of the engine's
-``mbs_models.final_metrics`` (the two implementations are compared by the tests).
+``mbs_models.engine.final_metrics`` (the two implementations are compared by the tests).
 
 For a dissipative scene the mechanical energy
 ``E = kinetic + recoil spring + absorber spring + contact elastic`` (J, see

@@ -192,7 +192,7 @@ def reference_forward(rtol: float = 1e-8, atol: float = 1e-11, method: str = "DO
 def engine_forward(accuracy: Any = "standard", **options) -> Callable:
     """Forward model ``simulate(scene, end_time)`` using the Exudyn engine, :func:`mbs_models.simulate`."""
     def simulate(scene: Scene, end_time: float):
-        from mbs_models.simulation import simulate as run
+        from mbs_models.engine.simulation import simulate as run
         return run(scene, end_time, accuracy, **options)
     simulate.label = f"Exudyn engine (accuracy {accuracy if isinstance(accuracy, str) else 'custom'})"
     simulate.builtin = "engine"

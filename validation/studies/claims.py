@@ -10,7 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Callable
 
-from mbs_models.result import Result
+from mbs_models.results.result import Result
 
 from .paper import MODEL_I, MODEL_II, SIMPLIFIED, QualitativeClaim, qualitative_claims
 

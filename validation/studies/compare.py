@@ -12,9 +12,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from mbs_models import simulate
-from mbs_models.accuracy import SolverSettings
-from mbs_models.peaks import HermiteTrajectory
-from mbs_models.result import Result
+from mbs_models.engine.accuracy import SolverSettings
+from mbs_models.results.peaks import HermiteTrajectory
+from mbs_models.results.result import Result
 from mbs_models.scene import Scene
 
 from ..reference import solve_reference

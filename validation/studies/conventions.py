@@ -6,7 +6,7 @@ the Fig. 5 trend (model (ii), m = 1000 kg, gaps 0 / 40 / 80 mm) are computed wit
 reference; the engine runs the same scenes so that its agreement is shown for every case (a reading
 the engine cannot integrate -- a sticking contact -- is reported as such, not hidden).  Every run
 stops as soon as its energy bounds prove the studied peak metrics final (the values are those of
-the full 10 s run; see :mod:`validation.reference.finality` and :mod:`mbs_models.final_metrics`).
+the full 10 s run; see :mod:`validation.reference.finality` and :mod:`mbs_models.engine.final_metrics`).
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from dataclasses import dataclass, field, fields
 from mbs_models import Conventions, model_i, model_ii, simplified_model, simulate
 from mbs_models.errors import SimulationError
 from mbs_models.scene import Scene
-from mbs_models.sweep import parallel_map
+from mbs_models.studies.sweep import parallel_map
 
 from .paper import MODEL_I, MODEL_II, SIMPLIFIED, TABLE2_MASSES, published, table2
 from ..reference import solve_reference

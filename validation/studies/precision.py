@@ -7,7 +7,7 @@ The study
 One scene (the shipped ``model_ii``, m = 1000 kg, gap 0, by default) is solved with a grid of settings
 (:func:`default_grid`):
 
-* every Exudyn dynamic solver the engine accepts (:data:`mbs_models.accuracy.SOLVERS`): the adaptive
+* every Exudyn dynamic solver the engine accepts (:data:`mbs_models.engine.accuracy.SOLVERS`): the adaptive
   ones (DOPRI5, ODE23) swept over the relative tolerance (absolute tolerance ``rtol * 1e-2``, max step
   :data:`STUDY_MAX_STEP`), the fixed-step explicit (RK44, RK67, RK33, ExplicitMidpoint, ExplicitEuler,
   VelocityVerlet) and implicit (GeneralizedAlpha, TrapezoidalIndex2) ones over the step size; with
@@ -65,7 +65,7 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import minimize_scalar
 
 from mbs_models.scene.models import model_i, model_ii, simplified_model
-from mbs_models.peaks import runs_of_true
+from mbs_models.results.peaks import runs_of_true
 from mbs_models.scene import Scene
 
 from ..reference.equations import Parameters
@@ -147,8 +147,8 @@ class Setting:
         return f"{self.family} {self.parameter}={self.value:g}{unit}"
 
     def solver_settings(self):
-        """The engine's :class:`~mbs_models.accuracy.SolverSettings` (Exudyn settings only)."""
-        from mbs_models.accuracy import SolverSettings
+        """The engine's :class:`~mbs_models.engine.accuracy.SolverSettings` (Exudyn settings only)."""
+        from mbs_models.engine.accuracy import SolverSettings
 
         if self.adaptive:
             return SolverSettings(solver=self.solver, relative_tolerance=self.relative_tolerance,
@@ -159,7 +159,7 @@ class Setting:
 
 
 def _exudyn(solver: str, values: Sequence[float], user_functions: str = "symbolic") -> list[Setting]:
-    from mbs_models.accuracy import ADAPTIVE_SOLVERS
+    from mbs_models.engine.accuracy import ADAPTIVE_SOLVERS
 
     if solver in ADAPTIVE_SOLVERS:
         return [Setting("exudyn", solver, relative_tolerance=v, user_functions=user_functions) for v in values]
@@ -270,7 +270,7 @@ def _truth_job(job: tuple[Scene, float, float | None]) -> Truth:
 def compute_truths(scenes: Sequence[Scene], end_time: float = 10.0, *, check_rtol: float | None = None,
                    workers: int | None = None, progress: Progress = _silent) -> list[Truth]:
     """:func:`compute_truth` of many scenes in worker processes (not timed, so parallel is fine)."""
-    from mbs_models.sweep import parallel_map
+    from mbs_models.studies.sweep import parallel_map
 
     return parallel_map(_truth_job, [(s, float(end_time), check_rtol) for s in scenes], workers=workers,
                         progress=lambda i, n: progress(f"truth {i}/{n}"))
@@ -533,7 +533,7 @@ def _sample_episodes(force: np.ndarray | None, threshold: float) -> int:
 
 
 def _engine_values(result, truth: Truth) -> RunValues:
-    from mbs_models.peaks import HermiteTrajectory
+    from mbs_models.results.peaks import HermiteTrajectory
 
     trajectory = HermiteTrajectory(result.time, result.barrel_position, result.barrel_velocity)(truth.grid)
     return RunValues(max_barrel_displacement=result.max_barrel_displacement,
@@ -557,8 +557,8 @@ def unguarded_run(setting: Setting, scene: Scene, truth: Truth) -> str:
     happens (used for settings the engine refuses): ``"<class>: <what>"``."""
     import exudyn
 
-    from mbs_models.assembly import assemble
-    from mbs_models.simulation import exudyn_simulation_settings
+    from mbs_models.engine.assembly import assemble
+    from mbs_models.engine.simulation import exudyn_simulation_settings
 
     settings = setting.solver_settings()
     end_time = truth.end_time
@@ -613,7 +613,7 @@ def _run_once(setting: Setting, scene: Scene, end_time: float, impact_threshold:
         solution = solve_plain(scene, end_time, setting.solver, setting.relative_tolerance,
                                max_step=setting.max_step, impact_threshold=impact_threshold)
         return solution, time.perf_counter() - wall, time.process_time() - cpu
-    from mbs_models.simulation import simulate
+    from mbs_models.engine.simulation import simulate
 
     settings = setting.solver_settings()
     wall, cpu = time.perf_counter(), time.process_time()
@@ -834,7 +834,7 @@ class Study:
     def figure(self, metric: str):
         """Log-log work-precision figure of one metric: relative error vs median wall time, one line per
         family; left the complete run (what a user waits for), right the integration alone."""
-        from mbs_models.plotting import new_figure
+        from mbs_models.results.plotting import new_figure
 
         fig, axes = new_figure(1, 2, width=14.0, row_height=7.0)
         families = list(dict.fromkeys(o.setting.family for o in self.outcomes))
@@ -873,7 +873,7 @@ class Study:
     def write(self, out: str | Path) -> dict[str, Path]:
         """Write ``precision.csv``, ``precision.json``, ``precision.md`` and one figure per metric."""
         from mbs_models.outputs import atomic_write_json, atomic_write_text, prepare_output_dir
-        from mbs_models.plotting import save_figure
+        from mbs_models.results.plotting import save_figure
 
         directory = prepare_output_dir(out)
         written = {"csv": atomic_write_text(directory / "precision.csv", self.csv_text()),
@@ -905,7 +905,7 @@ def _fmt(value, spec: str = ".6g") -> str:
 
 def _warm_up(scene: Scene, end_time: float) -> None:
     """One untimed run, so that first-call costs (Exudyn, symbolic recording, numpy) are not timed."""
-    from mbs_models.simulation import simulate
+    from mbs_models.engine.simulation import simulate
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -1062,8 +1062,8 @@ def preset_study(presets: dict[str, Any] | None = None, cases: Sequence[tuple[st
                  workers: int | None = None, progress: Progress = _silent) -> PresetStudy:
     """Run each preset (name -> SolverSettings; default ACCURACY_PRESETS) on ``cases`` (default the 19
     paper cases) against a truth per case (computed in parallel if not given); time each run serially."""
-    from mbs_models.accuracy import ACCURACY_PRESETS
-    from mbs_models.simulation import simulate
+    from mbs_models.engine.accuracy import ACCURACY_PRESETS
+    from mbs_models.engine.simulation import simulate
 
     presets = dict(presets or ACCURACY_PRESETS)
     cases = list(cases if cases is not None else paper_cases())

@@ -28,10 +28,10 @@ import numpy as np
 from mbs_models import model_i, model_ii, simplified_model, simulate
 from mbs_models.scene.models import model_i as _model_i_doc, model_ii as _model_ii_doc, simplified_model as _simp_doc
 from mbs_models.outputs import atomic_write_json, atomic_write_text, prepare_output_dir
-from mbs_models.plotting import (MODEL_COLOURS, figure_png, new_figure, plot_barrel_displacements,
+from mbs_models.results.plotting import (MODEL_COLOURS, figure_png, new_figure, plot_barrel_displacements,
                                  plot_contact_histories, plot_first_impact)
 from mbs_models.scene import Scene
-from mbs_models.sweep import parallel_map, run_sweep
+from mbs_models.studies.sweep import parallel_map, run_sweep
 
 from .claims import ClaimEvidence, evaluate_claims
 from .compare import compare
@@ -112,7 +112,7 @@ def compute_report(options: ReportOptions = ReportOptions(), progress: Progress 
     """Run every computation of the report; return a dict of results (figures are made later)."""
     timings: dict[str, float] = {}
     data: dict = {"options": {k: v for k, v in options.__dict__.items()}}
-    from mbs_models.sweep import default_workers
+    from mbs_models.studies.sweep import default_workers
     data["machine"] = {"cpus": os.cpu_count(), "workers": options.workers or default_workers(),
                        "load_average_at_start": round(os.getloadavg()[0], 2) if hasattr(os, "getloadavg") else None}
 

@@ -1,11 +1,11 @@
-"""Refinement of extrema and crossings between samples (mbs_models.peaks)."""
+"""Refinement of extrema and crossings between samples (mbs_models.results.peaks)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from mbs_models.peaks import HermiteTrajectory, refine_crossing, refine_function_maximum, refine_maximum, runs_of_true
+from mbs_models.results.peaks import HermiteTrajectory, refine_crossing, refine_function_maximum, refine_maximum, runs_of_true
 
 
 def test_hermite_reproduces_cubics_exactly():

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import pytest
 
-from mbs_models.accuracy import ACCURACY_PRESETS
+from mbs_models.engine.accuracy import ACCURACY_PRESETS
 from validation.studies.compare import DEFAULT_TOLERANCES
 from validation.studies.precision import PRESET_ERROR_BOUNDS, PRESET_METRICS, paper_cases, preset_study
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from mbs_models import RecoilDamper, model_i, model_ii, simplified_model
-from mbs_models.assembly import assemble
+from mbs_models.engine.assembly import assemble
 
 
 def _inventory(assembly):
@@ -50,11 +50,11 @@ def test_models_with_absorber(factory, mount_is_barrel, backend):
         types, user_functions, nodes = _inventory(assembly)
         assert nodes == 3
         assert types.count("Mass1D") == 2
-        assert set(assembly.connectors) == {"recoil_spring", "recoil_damper", "absorber_spring_damper", "contact"}
+        assert set(assembly.connectors) == {"recoil_spring", "recoil_damper", "absorber_damper", "contact"}
         assert sorted(assembly.user_function_connectors) == ["contact", "recoil_damper"]
         assert len(user_functions) == 2
         mbs = assembly.mbs
-        absorber_link = mbs.GetObject(assembly.connectors["absorber_spring_damper"])
+        absorber_link = mbs.GetObject(assembly.connectors["absorber_damper"])
         mount_marker = mbs.GetMarker(absorber_link["markerNumbers"][0])
         mount_node = int(mount_marker["nodeNumber"])
         assert (mount_node == int(assembly.nodes["barrel"])) == mount_is_barrel

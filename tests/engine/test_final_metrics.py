@@ -1,4 +1,4 @@
-"""Early stop of the engine (simulate(stop_when_final=...), mbs_models.final_metrics).
+"""Early stop of the engine (simulate(stop_when_final=...), mbs_models.engine.final_metrics).
 
 The early-stopped metrics must be those of the full run (the window contains the maximum, the
 solver's steps are the same), unproven metrics must be None, and the energy bounds must really
@@ -13,13 +13,14 @@ import numpy as np
 import pytest
 
 from mbs_models import Conventions, SceneError, model_i, model_ii, simplified_model, simulate
-from mbs_models import final_metrics as fm
-from mbs_models.sweep import run_sweep
+from mbs_models.engine import final_metrics as fm
+from mbs_models.studies.sweep import run_sweep
 
 ALL = fm.FINAL_METRICS
 TIMES = {"max_barrel_displacement": "time_of_max_barrel_displacement",
          "peak_contact_force": "time_of_peak_contact_force",
-         "max_absorber_velocity": "time_of_max_absorber_velocity"}
+         "max_absorber_velocity": "time_of_max_absorber_velocity",
+         "peak_support_force": "time_of_peak_support_force"}
 
 
 def _soft(scene):
@@ -128,7 +129,7 @@ def test_zero_recoil_stiffness_has_no_displacement_bound():
 
 
 def test_an_energy_rise_beyond_the_slack_makes_the_run_go_to_the_end(monkeypatch):
-    import mbs_models.simulation as simulation
+    import mbs_models.engine.simulation as simulation
 
     monkeypatch.setattr(simulation, "ENERGY_SLACK", -1.0)  # any history "rises" more than this
     result = simulate(model_ii(1000.0, 0.0), 3.0, stop_when_final=("max_barrel_displacement",))
@@ -158,11 +159,10 @@ def test_the_bounds_bound_everything_later_in_a_simulated_run(key):
     """Along a full run: max over [t_i, 10 s] of each quantity <= its bound from E(t_i) (no slack)."""
     scene, result = SCENES[key], _full(key)
     b = fm.EnergyBounds(scene)
-    absorber = scene.absorber is not None
-    x_M, v_M = result.barrel_position, result.barrel_velocity
-    x_m = result.absorber_position if absorber else np.zeros_like(x_M)
-    v_m = result.absorber_velocity if absorber else np.zeros_like(x_M)
-    energy = np.array([b.energy(*state) for state in zip(x_M, v_M, x_m, v_m)])
+    bodies = [body.name for body in b.mechanism.bodies]
+    x = np.array([result.positions[name] for name in bodies]).T
+    v = np.array([result.velocities[name] for name in bodies]).T
+    energy = np.array([b.energy(xi, vi) for xi, vi in zip(x, v)])
     np.testing.assert_allclose(energy, result.kinetic_energy_history + result.stored_energy_history,
                                rtol=1e-9, atol=1e-9 * energy[0])
 
@@ -171,19 +171,23 @@ def test_the_bounds_bound_everything_later_in_a_simulated_run(key):
 
     tolerance = 1e-7  # the solution's own energy error (it is not exactly dissipative)
     margin = 1.0 + tolerance
+    x_M = result.barrel_position
     bound_x = np.sqrt(2 * energy * margin / scene.recoil_spring.stiffness)
     assert np.all(future_max(x_M) <= np.array([b.barrel_displacement(e * margin) for e in energy]) + 1e-15)
     assert np.allclose([b.barrel_displacement(e) for e in energy], bound_x / math.sqrt(margin))
-    if not absorber:  # all the energy is the barrel's: the bound is reached at the maximum
+    support = np.abs(result.support_force)
+    assert np.all(future_max(support) <= np.array([b.support_force_bound(e * margin) for e in energy]) * (1 + 1e-12))
+    if scene.absorber is None:  # all the energy is the barrel's: the bound is reached at the maximum
         assert np.min(bound_x / np.maximum(future_max(x_M), 1e-300)) < 1.0 + 1e-6
-    if not absorber:
         return
+    x_m, v_M, v_m = result.absorber_position, result.barrel_velocity, result.absorber_velocity
+    contact = b.contacts[0]
     checks = {
-        "absorber_velocity": (np.abs(v_m), b.absorber_velocity),
-        "relative_displacement": (x_M - x_m, b.relative_displacement),
-        "penetration": (np.maximum(x_M - x_m - b.gap_offset, 0.0), b.penetration),
-        "penetration_rate": (np.abs(v_M - v_m), b.penetration_rate),
-        "contact_force": (result.contact_force, b.contact_force_bound),
+        "absorber_velocity": (np.abs(v_m), lambda e: b.body_velocity(1, e)),
+        "relative_displacement": (x_M - x_m, lambda e: b.contact_coordinate(0, e)),
+        "penetration": (np.maximum(x_M - x_m - contact.offset, 0.0), lambda e: b.penetration(0, e)),
+        "penetration_rate": (np.abs(v_M - v_m), lambda e: b.penetration_rate(0, e)),
+        "contact_force": (result.contact_force, lambda e: b.contact_force_bound(0, e)),
     }
     for name, (values, bound) in checks.items():
         bounds = np.array([bound(e * margin) for e in energy])
@@ -192,18 +196,28 @@ def test_the_bounds_bound_everything_later_in_a_simulated_run(key):
         assert np.all(np.isfinite(bounds)), name
 
 
+def test_the_bound_coefficients_are_the_closed_forms_of_the_paper_models():
+    """The quadratic form of the springs gives x_M <= sqrt(2E/k), x_M - x_m <= sqrt(2E/k_r) (absorber on
+    the barrel) and sqrt(2E (1/k + 1/k_r)) (on the ground)."""
+    k, kr, energy = 27500.0, 13500.0, 1336.0
+    for factory, relative in ((model_i, 2 * energy / kr), (model_ii, 2 * energy * (1 / k + 1 / kr))):
+        b = fm.EnergyBounds(factory(1000.0, 0.1))
+        assert b.barrel_displacement(energy) == pytest.approx(math.sqrt(2 * energy / k), rel=1e-12)
+        assert b.contact_coordinate(0, energy) == pytest.approx(math.sqrt(relative), rel=1e-12)
+    free = fm.EnergyBounds(model_ii(1000.0, 0.0).with_changes(**{"absorber.stiffness": 0.0}))
+    assert free.contact_coordinate(0, energy) == math.inf  # no spring holds the absorber
 
-def test_the_contact_force_law_matches_the_engines():
-    from mbs_models import forces
 
+def test_the_tracker_evaluates_each_contact_with_its_law():
     for scene in (model_ii(), model_ii(100.0, 0.04, Conventions(literal_gap_sign=True)),
                   model_i(500.0, 0.0, Conventions(compression_only=True)),
                   model_ii(500.0, 0.0, Conventions(literal_lambda_sign=True))):
         b = fm.EnergyBounds(scene)
+        contact = b.contacts[0]
         for rel in (-0.01, 0.0, 1e-4, 0.003, 0.05):
             for rate in (-3.0, -1.0, -0.1, 0.0, 0.2, 2.0):
-                expected = forces.hunt_crossley_force(rel, rate, scene.contact, scene.conventions)
-                assert b.contact_force(rel, rate) == pytest.approx(expected, rel=1e-14, abs=0.0)
+                expected = float(contact.force(np.array([rel]), np.array([rate]))[0])  # the numpy backend
+                assert b.contact_force(contact, [rel, 0.0], [rate, 0.0]) == pytest.approx(expected, rel=1e-14, abs=0.0)
 
 
 def test_largest_energy_rise():
@@ -214,18 +228,18 @@ def test_largest_energy_rise():
 
 def test_tracker_proves_nothing_for_a_scene_that_injects_energy():
     tracker = fm.FinalityTracker(model_ii(1000.0, 0.0, Conventions(literal_lambda_sign=True)), ALL, 1000.0)
-    tracker.observe(0.0, 0.2, 0.0, 0.0, 0.0)
-    tracker.observe_last(1.0, 0.0, 0.0, 0.0, 0.0)  # zero energy: every bound would be 0
+    tracker.observe(0.0, [0.2, 0.0], [0.0, 0.0])
+    tracker.observe_last(1.0, [0.0, 0.0], [0.0, 0.0])  # zero energy: every bound would be 0
     assert not tracker.done and not tracker.final
 
 
 def test_tracker_on_a_simple_state():
     scene = simplified_model()
     tracker = fm.FinalityTracker(scene, ("max_barrel_displacement",), 1000.0)
-    tracker.observe(0.1, 0.1, 0.0)                    # E = k 0.1^2 / 2: the bound equals the maximum seen ...
+    tracker.observe(0.1, [0.1], [0.0])                # E = k 0.1^2 / 2: the bound equals the maximum seen ...
     assert not tracker.done                            # ... and the slack keeps it from counting
     x = 0.1 / math.sqrt(2.0)                           # E halves: bound 0.0707 m < 0.1 m seen
-    tracker.observe(0.2, x, 0.0)
+    tracker.observe(0.2, [x], [0.0])
     assert tracker.done and tracker.final_at["max_barrel_displacement"] == 0.2
 
 

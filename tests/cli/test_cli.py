@@ -56,7 +56,7 @@ def test_console_script_reports_without_traceback(tmp_path):
     path.write_text(scene_to_toml(model_ii()).replace("gap = 0.0", "gap = -0.5"))
     proc = subprocess.run([sys.executable, "-m", "mbs_models", "run", str(path)], capture_output=True, text=True)
     assert proc.returncode == 2
-    assert proc.stderr.strip() == "recoil: error: contact.gap: must be >= 0 m, got -0.5"
+    assert proc.stderr.strip() == "recoil: error: absorber.contact.gap: must be >= 0 m, got -0.5"
 
 
 @pytest.mark.parametrize("argv, needle", [

@@ -1,6 +1,6 @@
-"""The step budget that stops collapsing adaptive solves (mbs_models.guard)."""
+"""The step budget that stops collapsing adaptive solves (mbs_models.engine.guard)."""
 
-from mbs_models.guard import MINIMUM_STEP_BUDGET, StepBudget, step_budget
+from mbs_models.engine.guard import MINIMUM_STEP_BUDGET, StepBudget, step_budget
 
 
 def test_budget_grows_with_end_time_and_has_a_floor():
@@ -16,7 +16,7 @@ def test_budget_stops_after_max_steps_and_explains():
 
 
 def test_stall_is_detected_long_before_the_budget():
-    from mbs_models.guard import STALL_WINDOW_STEPS, STALL_WINDOW_TIME
+    from mbs_models.engine.guard import STALL_WINDOW_STEPS, STALL_WINDOW_TIME
 
     budget = StepBudget(10 * STALL_WINDOW_STEPS)
     step = 0.1 * STALL_WINDOW_TIME / STALL_WINDOW_STEPS
@@ -26,7 +26,7 @@ def test_stall_is_detected_long_before_the_budget():
 
 
 def test_steady_small_steps_are_not_a_stall():
-    from mbs_models.guard import STALL_WINDOW_STEPS, STALL_WINDOW_TIME
+    from mbs_models.engine.guard import STALL_WINDOW_STEPS, STALL_WINDOW_TIME
 
     budget = StepBudget(10 * STALL_WINDOW_STEPS)
     step = 2.0 * STALL_WINDOW_TIME / STALL_WINDOW_STEPS

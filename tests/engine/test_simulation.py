@@ -7,7 +7,9 @@ import math
 import numpy as np
 import pytest
 
-import mbs_models.forces as forces
+import mbs_models.elements.contact_laws as contact_laws
+import mbs_models.elements.recoil_damper as recoil_damper
+from mbs_models.elements.ops import PYTHON_OPS
 from mbs_models import (ACCURACY_PRESETS, SceneError, SimulationError, SolverSettings, model_i, model_ii,
                         simplified_model, simulate)
 
@@ -122,19 +124,19 @@ def test_exception_in_python_user_function_is_a_simulation_error(monkeypatch):
     def broken(*args, **kwargs):
         raise ZeroDivisionError("deliberate failure inside the contact law")
 
-    monkeypatch.setattr(forces, "hunt_crossley_force", broken)
+    monkeypatch.setattr(contact_laws, "law_force", broken)
     with pytest.raises(SimulationError, match="deliberate failure"):
         simulate(model_ii(), 0.1, user_functions="python")
 
 
 def test_nan_from_user_function_is_a_simulation_error(monkeypatch):
-    original = forces.recoil_damper_force
+    original = recoil_damper.recoil_damper_force
 
-    def poisoned(velocity, damper, ops=forces.PYTHON_OPS):
+    def poisoned(velocity, damper, ops=PYTHON_OPS):
         value = original(velocity, damper, ops)
         return math.nan if velocity < 0 else value
 
-    monkeypatch.setattr(forces, "recoil_damper_force", poisoned)
+    monkeypatch.setattr(recoil_damper, "recoil_damper_force", poisoned)
     with pytest.raises(SimulationError, match="non-finite"):
         simulate(simplified_model(), 2.0, user_functions="python")
 
@@ -157,7 +159,7 @@ def test_chattering_contact_fails_clearly_instead_of_running_for_hours():
 @pytest.mark.parametrize("factory", [simplified_model, model_ii])
 def test_solver_that_stops_early_with_success_is_a_simulation_error(monkeypatch, factory):
     """Exudyn told to stop at half the end time returns success; that must not pass as a result."""
-    import mbs_models.simulation as simulation
+    import mbs_models.engine.simulation as simulation
 
     original = simulation.exudyn_simulation_settings
 

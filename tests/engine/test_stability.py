@@ -1,4 +1,4 @@
-"""mbs_models.stability: contact time scales, unsafe solver settings, stepped-over contacts.
+"""mbs_models.engine.stability: contact time scales, unsafe solver settings, stepped-over contacts.
 
 The claims checked here: the stability polynomials are Exudyn's own (measured one-step
 amplification); the contact estimate matches the reference's first impact; a refused fixed step
@@ -19,10 +19,10 @@ import pytest
 from exudyn.itemInterface import (MarkerNodeCoordinate, NodeGenericODE2, NodePointGround,
                                   ObjectConnectorCoordinateSpringDamper, ObjectMass1D)
 
-import mbs_models.stability as stability
+import mbs_models.engine.stability as stability
 from mbs_models import SceneError, SimulationError, SolverSettings, model_i, model_ii, simplified_model, simulate
-from mbs_models.accuracy import FIXED_STEP_SOLVERS, IMPLICIT_SOLVERS
-from mbs_models.stability import AccuracyWarning
+from mbs_models.engine.accuracy import FIXED_STEP_SOLVERS, IMPLICIT_SOLVERS
+from mbs_models.engine.stability import AccuracyWarning
 from validation.reference import solve_reference
 
 EXPLICIT_FIXED = [s for s in FIXED_STEP_SOLVERS if s not in IMPLICIT_SOLVERS]

@@ -1,11 +1,11 @@
-"""Parallel sweeps (mbs_models.sweep): same numbers as serial runs, failures kept per point."""
+"""Parallel sweeps (mbs_models.studies.sweep): same numbers as serial runs, failures kept per point."""
 
 from __future__ import annotations
 
 import pytest
 
 from mbs_models import Conventions, SceneError, model_i, model_ii, simulate
-from mbs_models.sweep import gap_sweep, parallel_map, run_sweep
+from mbs_models.studies.sweep import gap_sweep, parallel_map, run_sweep
 
 
 def test_parallel_gap_sweep_equals_serial_simulate():
