@@ -129,7 +129,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     run = sub.add_parser("run", help="simulate one scene and print its metrics")
-    run.add_argument("scene", help="scene TOML file (or a shipped scene: simplified, model_i, model_ii)")
+    run.add_argument("scene", help="scene TOML file, or the name of a shipped scene (see the README: model_i, model_ii, two_absorbers, ...)")
     run.add_argument("--end-time", type=float, default=10.0, help="simulated time in s (default 10)")
     run.add_argument("--accuracy", default="standard", choices=("draft", "standard", "reference"))
     run.add_argument("--json", action="store_true", help="print the metrics as one JSON object")
@@ -142,7 +142,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     validate = sub.add_parser("validate", help="engine vs the independent scipy reference for one scene "
                                                "(exit code 1 if a tolerance is exceeded)")
-    validate.add_argument("scene", help="scene TOML file (or a shipped scene: simplified, model_i, model_ii)")
+    validate.add_argument("scene", help="scene TOML file, or the name of a shipped scene (see the README: model_i, model_ii, two_absorbers, ...)")
     validate.add_argument("--end-time", type=float, default=10.0, help="simulated time in s (default 10)")
     validate.add_argument("--accuracy", default="standard", choices=("draft", "standard", "reference"))
     validate.add_argument("--impact-threshold", type=float, default=1000.0, help="impact threshold in N")

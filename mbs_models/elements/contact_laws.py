@@ -102,11 +102,24 @@ def _g(z: float) -> float:
     return z - math.log1p(z)
 
 
+def _exp_minus_one_minus(L: float) -> float:
+    """``exp(L) - 1 - L`` (series for small ``|L|``: no cancellation)."""
+    if abs(L) < 1e-3:
+        term, total = L * L / 2.0, 0.0
+        for k in range(3, 16):
+            total += term
+            term *= L / k
+        return total
+    return math.expm1(L) - L
+
+
 def exact_restitution_factor(restitution: float) -> float:
     """``chi`` of ``exact-restitution``: the root in ``(0, 1/e)`` of ``g(chi) = g(-chi e)``, ``g(z) = z - ln(1 + z)``.
 
-    ``h(chi) = g(chi) - g(-chi e)`` is ``(1 - e^2) chi^2 / 2 > 0`` near 0 and tends to -inf as
-    ``chi -> 1/e`` (``g(-1) = inf``), so the root is bracketed; ``e = 1`` gives 0.
+    Solved for ``L = ln(1 - chi e)`` (so ``chi = (1 - exp(L)) / e``): ``g(-chi e) = exp(L) - 1 - L``, and
+    ``F(L) = g((1 - e^L)/e) - (e^L - 1 - L)`` is ``(1/e^2 - 1) L^2 / 2 > 0`` near 0 and negative at
+    ``L = -(g(1/e) + 2)``.  For small e the root has ``chi e`` within round-off of 1, which this form
+    still resolves.  ``e = 1`` gives 0.
     """
     e = float(restitution)
     if not 0.0 < e <= 1.0:
@@ -115,15 +128,13 @@ def exact_restitution_factor(restitution: float) -> float:
         return 0.0
     from scipy.optimize import brentq
 
-    def h(chi: float) -> float:
-        return _g(chi) - _g(-chi * e)
+    def F(L: float) -> float:
+        return _g(-math.expm1(L) / e) - _exp_minus_one_minus(L)
 
-    upper = 1.0 / e
-    # h -> -inf at 1/e; step towards it until h < 0 (it gets there within a hair of 1/e for e -> 0)
-    high = upper * (1.0 - 1e-3)
-    while h(high) >= 0.0:
-        high = upper - 0.5 * (upper - high)
-    return brentq(h, 1e-300, high, xtol=1e-300, rtol=4 * 2.2e-16, maxiter=500)
+    low = -(_g(1.0 / e) + 2.0)
+    high = -1e-6 * (1.0 - e)
+    L = brentq(F, low, high, xtol=1e-300, rtol=8.9e-16, maxiter=500)
+    return -math.expm1(L) / e
 
 
 def restitution_factor(law: str, restitution: float) -> float:

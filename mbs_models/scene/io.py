@@ -183,8 +183,13 @@ def _table_lines(header: str, values: dict[str, Any], path: str) -> list[str]:
 
 def scene_to_toml(scene: Scene) -> str:
     """Serialise a scene to version-2 TOML text (round-trips through :func:`load_scene`)."""
-    data = scene_to_dict(scene)
-    lines = [f"version = {data.pop('version')}", f"name = {_toml_value(data.pop('name'))}"]
+    return mapping_to_toml(scene_to_dict(scene))
+
+
+def mapping_to_toml(data: dict[str, Any]) -> str:
+    """TOML text of a scene mapping (scalars at the top, tables, arrays of tables with their sub-tables)."""
+    data = dict(data)
+    lines = [f"{key} = {_toml_value(data.pop(key))}" for key in list(data) if not isinstance(data[key], (dict, list))]
     for table, values in data.items():
         if isinstance(values, list):
             for item in values:
@@ -194,4 +199,5 @@ def scene_to_toml(scene: Scene) -> str:
     return "\n".join(lines) + "\n"
 
 
-__all__ = ["FORMAT_VERSION", "FORMAT_VERSIONS", "load_scene", "scene_from_dict", "scene_to_dict", "scene_to_toml"]
+__all__ = ["FORMAT_VERSION", "FORMAT_VERSIONS", "load_scene", "scene_from_dict", "scene_to_dict", "scene_to_toml",
+           "mapping_to_toml"]

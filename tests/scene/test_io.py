@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import math
+import tomllib
 
 import pytest
 
 from mbs_models import (Absorber, Barrel, Contact, Conventions, SceneError, load_scene, model_i, model_ii,
                         scene_from_dict, scene_to_dict, scene_to_toml, simplified_model)
+from mbs_models.scene import CONTACT_LAWS
 from mbs_models.scenes import list_scenes, scene_path
 
 
@@ -54,8 +56,14 @@ def test_toml_round_trip(tmp_path, scene):
     assert scene_from_dict(scene_to_dict(scene)) == scene
 
 
-def test_shipped_scenes_are_the_paper_models():
-    assert list_scenes() == ["model_i", "model_ii", "simplified"]
+def test_shipped_scenes_are_the_paper_models_and_the_examples():
+    assert {"model_i", "model_ii", "simplified"} <= set(list_scenes())
+    examples = set(list_scenes()) - {"model_i", "model_ii", "simplified"}
+    assert {"two_absorbers", "end_stops"} <= examples
+    assert {f"contact_{law.replace('-', '_')}" for law in CONTACT_LAWS} <= examples
+    for name in examples:
+        scene = load_scene(scene_path(name))  # every example is a valid version-2 scene
+        assert tomllib.loads(scene_path(name).read_text())["version"] == 2 and scene.name
     assert load_scene(scene_path("simplified")) == simplified_model()
     assert load_scene(scene_path("model_i")) == model_i(1000.0, 0.0)
     assert load_scene(scene_path("model_ii")) == model_ii(1000.0, 0.0)
