@@ -73,10 +73,11 @@ def breakdown_round(scene, end_time: float, stages: dict[str, list[float]]) -> N
     """One ``standard`` run called stage by stage as ``simulate`` does; appends each stage's time (s)."""
     import importlib
 
-    from mbs_models import stability
+    from mbs_models.engine import stability
     from mbs_models.engine.accuracy import solver_settings_for
     from mbs_models.engine.assembly import assemble
-    from mbs_models.results.postprocess import _Interpolant, analyse, energies, find_impacts
+    from mbs_models.engine.mechanism import Mechanism
+    from mbs_models.results.postprocess import Interpolant, analyse, energies, find_impacts
 
     engine = importlib.import_module("mbs_models.engine.simulation")
     settings = solver_settings_for("standard")
@@ -88,24 +89,24 @@ def breakdown_round(scene, end_time: float, stages: dict[str, list[float]]) -> N
         return value
 
     timed("settings check (stability)", stability.check_settings, scene, settings, end_time)
-    assembly = timed("assembly (incl. symbolic user functions)", assemble, scene, settings.user_functions)
+    mechanism = timed("mechanism (elements)", Mechanism, scene)
+    assembly = timed("assembly (incl. symbolic user functions)", assemble, scene, settings.user_functions, mechanism)
     try:
         accelerations = timed("initial accelerations", engine._initial_accelerations, assembly)
         timed("solve (Exudyn SolveDynamic)", engine._solve, assembly, settings, end_time)
-        samples, force = timed("collect sensor data", engine._collect, assembly, end_time, settings, accelerations)
+        samples = timed("collect sensor data", engine._collect, assembly, end_time, settings, accelerations)
     finally:
         timed("release model (Reset)", assembly.close)
-    if force is not None:
-        timed("stepped-over-contact check", stability.stepped_over_contacts, scene, samples.time,
-              samples.barrel_position - samples.absorber_position,
-              samples.barrel_velocity - samples.absorber_velocity, force, 1000.0)
-    metrics = timed("metrics (analyse)", analyse, scene, samples, force, 1000.0)
-    if force is not None:
-        timed("  of which: impacts (find_impacts)", find_impacts, scene, samples, force, _Interpolant(samples),
-              1000.0)
-    timed("  of which: energies", energies, scene, samples, _Interpolant(samples))
-    error = metrics.kinetic_energy_history + metrics.stored_energy_history + sum(
-        metrics.dissipated_energy_history.values()) - stability.initial_energy(scene)
+    timed("stepped-over-contact check", engine._settings_after_stepped_over_contacts, mechanism, samples, settings,
+          1000.0, 0)
+    metrics = timed("metrics (analyse)", analyse, mechanism, samples, 1000.0)
+    for contact in mechanism.contacts:
+        timed("  of which: impacts (find_impacts)", find_impacts, mechanism, contact, samples,
+              samples.forces[contact.name], Interpolant(samples), 1000.0)
+    timed("  of which: energies", energies, mechanism, samples, Interpolant(samples))
+    e = metrics.energies
+    error = e.kinetic_total + (e.stored_total if e.stored else 0.0) + sum(e.dissipated.values()) \
+        - mechanism.initial_energy()
     timed("energy-balance check", stability.check_energy_balance, scene, samples.time, error, "bench")
 
 
@@ -130,7 +131,7 @@ class CompiledDopri5:
 
     def prepare(self, scene, end_time: float, rtol: float, atol: float, max_step: float):
         """Allocate once; return a zero-argument callable that integrates and returns the sample count."""
-        from validation.reference.equations import Parameters
+        from validation.studies.precision import Parameters
 
         P = Parameters.from_scene(scene)
         params = np.array([P.M, P.k, P.c_recoil, P.c_counter, float(P.has_absorber), P.m, float(P.on_barrel), P.kr,
@@ -152,13 +153,20 @@ class CompiledDopri5:
             return count
         return run
 
-    def samples(self, count: int):
+    def samples(self, count: int, scene):
+        """The compiled run's samples as the engine's post-processing takes them (bodies, contact force)."""
         from mbs_models.results.postprocess import Samples
+        from validation.studies.precision import Parameters, plain_contact_force
 
         y, f = self.y[:count], self.f[:count]
-        return Samples(time=self.t[:count].copy(), barrel_position=y[:, 0].copy(), barrel_velocity=y[:, 1].copy(),
-                       barrel_acceleration=f[:, 1].copy(), absorber_position=y[:, 2].copy(),
-                       absorber_velocity=y[:, 3].copy(), absorber_acceleration=f[:, 3].copy())
+        names = ["barrel"] + (["absorber"] if scene.has_absorber else [])
+        samples = Samples(time=self.t[:count].copy(),
+                          positions={n: y[:, 2 * i].copy() for i, n in enumerate(names)},
+                          velocities={n: y[:, 2 * i + 1].copy() for i, n in enumerate(names)},
+                          accelerations={n: f[:, 2 * i + 1].copy() for i, n in enumerate(names)})
+        if scene.has_absorber:
+            samples.forces["contact"] = plain_contact_force(Parameters.from_scene(scene), y[:, :4].T)
+        return samples
 
 
 # ------------------------------------------------------------------------------------------------ memory
@@ -254,21 +262,19 @@ def main(argv=None) -> int:
         compiled_run = yardstick.prepare(scene, end_time, standard.relative_tolerance, standard.absolute_tolerance,
                                          standard.max_step)
         count = compiled_run()
+        from mbs_models.engine.mechanism import Mechanism
         from mbs_models.results.peaks import HermiteTrajectory
         from mbs_models.results.postprocess import analyse
-        from validation.reference.equations import Parameters
-        from validation.studies.precision import plain_contact_force
 
-        samples = yardstick.samples(count)
-        force = None
-        if scene.has_absorber:
-            state = np.vstack([samples.barrel_position, samples.barrel_velocity, samples.absorber_position,
-                               samples.absorber_velocity])
-            force = plain_contact_force(Parameters.from_scene(scene), state)
-        m = analyse(scene, samples, force, 1000.0)
-        values = RunValues(m.max_barrel_displacement, m.peak_contact_force, m.max_absorber_velocity,
-                           [(i.start, i.end, i.peak_force) for i in m.impacts],
-                           HermiteTrajectory(samples.time, samples.barrel_position, samples.barrel_velocity)(truth.grid))
+        samples = yardstick.samples(count, scene)
+        mechanism = Mechanism(scene)
+        m = analyse(mechanism, samples, 1000.0)
+        contact = m.contacts.get("contact")
+        v_max = m.max_velocity.get("absorber", (None, None))[0]
+        values = RunValues(m.max_barrel_displacement, None if contact is None else contact.peak_force, v_max,
+                           [] if contact is None else [(i.start, i.end, i.peak_force) for i in contact.impacts],
+                           HermiteTrajectory(samples.time, samples.positions["barrel"],
+                                             samples.velocities["barrel"])(truth.grid))
         compiled = (count - 1, relative_errors(values, truth), yardstick.compiler, int(yardstick.stats[1]))
 
     # ---------------------------------------------------------------- timing, interleaved rounds
@@ -296,7 +302,7 @@ def main(argv=None) -> int:
         if compiled_run is not None:
             for _ in range(5):
                 clock("compiled", compiled_run)
-            clock("compiled post", analyse, scene, samples, force, 1000.0)
+            clock("compiled post", analyse, mechanism, samples, 1000.0)
         breakdown_round(scene, end_time, stages)
     directory.cleanup()
     t = {name: statistics.median(values) for name, values in timings.items()}

@@ -46,39 +46,54 @@ def save_figure(fig: Figure, path: str | Path) -> Path:
     return atomic_write_bytes(path, figure_png(fig))
 
 
+#: Colours of the absorbers and contacts, in order (the barrel is dark grey).
+SERIES_COLOURS = ("#d62728", "#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#17becf")
+
+
+def _series_colour(i: int) -> str:
+    return SERIES_COLOURS[i % len(SERIES_COLOURS)]
+
+
 def plot_result(result: Result, *, title: str | None = None) -> Figure:
-    """Time histories of one run: barrel (and absorber) position; contact force; absorber velocity."""
-    has_absorber = result.absorber_position is not None
-    rows = 3 if has_absorber else 2
-    fig, axes = new_figure(rows, 1, row_height=2.6, sharex=True)
+    """Time histories of one run: positions; contact forces (one line per contact); the force on the
+    mount; velocities.  Every body and contact the scene has, none it lacks."""
+    contacts = list(result.contacts.values())
+    rows = 4 if contacts else 3
+    fig, axes = new_figure(rows, 1, row_height=2.4, sharex=True)
     ax = axes[0, 0]
     ax.plot(result.time, result.barrel_position * 1e3, color=MODEL_COLOURS["simplified"], label="barrel $x_M$")
-    if has_absorber:
-        ax.plot(result.time, result.absorber_position * 1e3, color=MODEL_COLOURS["model (ii)"], label="absorber $x_m$")
+    for i, name in enumerate(result.absorber_names):
+        ax.plot(result.time, result.positions[name] * 1e3, color=_series_colour(i), lw=1.0, label=f"{name} $x_m$")
     if result.max_barrel_displacement is not None:  # None: an early-stopped run that did not prove it final
         ax.plot([result.time_of_max_barrel_displacement], [result.max_barrel_displacement * 1e3], "ko", ms=4,
                 label=f"max {result.max_barrel_displacement * 1e3:.2f} mm")
     ax.set_ylabel("position [mm]")
     ax.legend(fontsize=8, loc="upper right")
-    ax = axes[1, 0]
-    if has_absorber:
-        ax.plot(result.time, result.contact_force / 1e3, color=MODEL_COLOURS["model (i)"], lw=1.0)
-        if result.peak_contact_force:
-            ax.plot([result.time_of_peak_contact_force], [result.peak_contact_force / 1e3], "ko", ms=4,
-                    label=f"peak {result.peak_contact_force / 1e3:.1f} kN")
-            ax.legend(fontsize=8, loc="upper right")
+    row = 1
+    if contacts:
+        ax = axes[row, 0]
+        for i, contact in enumerate(contacts):
+            peak = "" if not contact.peak_force else f", peak {contact.peak_force / 1e3:.1f} kN"
+            ax.plot(result.time, contact.force / 1e3, color=_series_colour(i), lw=1.0,
+                    label=f"{contact.name.replace('_', ' ')}{peak}")
         ax.set_ylabel("contact force [kN]")
-        ax = axes[2, 0]
-        ax.plot(result.time, result.absorber_velocity, color=MODEL_COLOURS["model (ii)"], lw=1.0,
-                label="absorber $\\dot x_m$")
-        ax.plot(result.time, result.barrel_velocity, color=MODEL_COLOURS["simplified"], lw=1.0,
-                label="barrel $\\dot x_M$")
-        ax.set_ylabel("velocity [m/s]")
         ax.legend(fontsize=8, loc="upper right")
-    else:
-        ax.plot(result.time, result.barrel_velocity, color=MODEL_COLOURS["simplified"], label="barrel $\\dot x_M$")
-        ax.set_ylabel("velocity [m/s]")
+        row += 1
+    ax = axes[row, 0]
+    ax.plot(result.time, result.support_force / 1e3, color="#444444", lw=1.0)
+    if result.peak_support_force is not None:
+        i = int(np.argmin(np.abs(result.time - result.time_of_peak_support_force)))
+        ax.plot([result.time_of_peak_support_force], [np.sign(result.support_force[i]) * result.peak_support_force / 1e3],
+                "ko", ms=4, label=f"peak |S| {result.peak_support_force / 1e3:.2f} kN")
         ax.legend(fontsize=8, loc="upper right")
+    ax.axhline(0.0, color="#999999", lw=0.6)
+    ax.set_ylabel("force on the mount [kN]")
+    ax = axes[row + 1, 0]
+    ax.plot(result.time, result.barrel_velocity, color=MODEL_COLOURS["simplified"], lw=1.0, label="barrel $\\dot x_M$")
+    for i, name in enumerate(result.absorber_names):
+        ax.plot(result.time, result.velocities[name], color=_series_colour(i), lw=1.0, label=f"{name} $\\dot x_m$")
+    ax.set_ylabel("velocity [m/s]")
+    ax.legend(fontsize=8, loc="upper right")
     axes[-1, 0].set_xlabel("time [s]")
     fig.suptitle(title or result.scene.name, fontsize=11)
     return fig

@@ -45,11 +45,13 @@ class SweepPoint:
     error: str | None = None
     end_time: float | None = None
     stop_reason: str | None = None
+    peak_support_force: float | None = None
 
     @property
     def gap(self) -> float | None:
-        """The scene's contact gap in m (None without an absorber)."""
-        return self.scene.contact.gap if self.scene.contact is not None else None
+        """The contact gap in m of the scene's one absorber (None without an absorber or with several)."""
+        absorbers = self.scene.absorbers
+        return absorbers[0].contact.gap if len(absorbers) == 1 else None
 
 
 def _run_one(job: tuple[Scene, float, str | SolverSettings, tuple[str, ...]]) -> SweepPoint:
@@ -63,7 +65,8 @@ def _run_one(job: tuple[Scene, float, str | SolverSettings, tuple[str, ...]]) ->
     return SweepPoint(scene, result.max_barrel_displacement, result.time_of_max_barrel_displacement,
                       result.peak_contact_force, result.max_absorber_velocity,
                       None if result.impacts is None else len(result.impacts), result.wall_time,
-                      end_time=result.end_time, stop_reason=result.stop_reason)
+                      end_time=result.end_time, stop_reason=result.stop_reason,
+                      peak_support_force=result.peak_support_force)
 
 
 def default_workers() -> int:

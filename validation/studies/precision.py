@@ -68,7 +68,6 @@ from mbs_models.scene.models import model_i, model_ii, simplified_model
 from mbs_models.results.peaks import runs_of_true
 from mbs_models.scene import Scene
 
-from ..reference.equations import Parameters
 
 #: Metrics of the study, in the order of the tables and figures.
 METRICS = ("max_barrel_displacement", "peak_contact_force", "max_absorber_velocity", "barrel_trajectory_l2")
@@ -329,6 +328,49 @@ def impact_mismatch(values: RunValues, truth: Truth) -> tuple[int, int]:
 
 # ================================================================================================
 # scipy on the same equations, without events
+
+@dataclass(frozen=True)
+class Parameters:
+    """The numbers of a paper scene (one Hunt-Crossley absorber at most) for the plain right-hand side, SI units.
+
+    ``lam`` is the signed damping factor (``-lambda`` with ``literal_lambda_sign``); ``gap_offset`` the gap
+    subtracted from ``x_M - x_m`` (``-gap`` with ``literal_gap_sign``).  The study covers the paper's
+    models: :meth:`from_scene` refuses scenes with several absorbers, stops or other contact laws.
+    """
+
+    M: float
+    k: float
+    c_recoil: float
+    c_counter: float
+    v0: float
+    has_absorber: bool = False
+    m: float = 1.0
+    on_barrel: bool = False
+    kr: float = 0.0
+    cr: float = 0.0
+    kc: float = 0.0
+    n: float = 1.0
+    lam: float = 0.0
+    gap_offset: float = 0.0
+    compression_only: bool = False
+
+    @classmethod
+    def from_scene(cls, scene: Scene) -> "Parameters":
+        if len(scene.absorbers) > 1 or scene.recoil_stop is not None or scene.battery_stop is not None or \
+                (scene.contact is not None and scene.contact.law != "hunt-crossley"):
+            raise ValueError("the work-precision study covers the paper's models: one Hunt-Crossley absorber, no stops")
+        spring, damper = scene.recoil_spring, scene.recoil_damper
+        base = dict(M=scene.barrel.mass, k=spring.stiffness if spring else 0.0,
+                    c_recoil=damper.recoil if damper else 0.0, c_counter=damper.counter_recoil if damper else 0.0,
+                    v0=float(scene.initial_velocity))
+        a, c, conv = scene.absorber, scene.contact, scene.conventions
+        if a is None:
+            return cls(**base)
+        return cls(**base, has_absorber=True, m=a.mass, on_barrel=(a.mount == "barrel"), kr=a.stiffness,
+                   cr=a.damping, kc=c.stiffness, n=c.exponent,
+                   lam=-c.damping_factor if conv.literal_lambda_sign else c.damping_factor,
+                   gap_offset=-c.gap if conv.literal_gap_sign else c.gap, compression_only=conv.compression_only)
+
 
 def plain_rhs(P: Parameters) -> Callable[[float, np.ndarray], list[float]]:
     """Right-hand side ``f(t, y)``, ``y = [x_M, v_M, x_m, v_m]``, of Eqs. (1)-(8) as the engine integrates
