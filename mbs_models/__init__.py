@@ -16,9 +16,10 @@ from __future__ import annotations
 import importlib
 
 from .errors import RecoilError, SceneError, SimulationError
-from .scene import (Absorber, Barrel, BatteryStop, Contact, Conventions, Firing, RecoilDamper, RecoilSpring, RecoilStop,
-                    Scene, load_scene, model_i, model_ii, paper_model, scene_from_dict, scene_to_dict, scene_to_toml,
-                    simplified_model)
+from .scene import (TABLE_CLASSES, Conventions, Scene, load_scene, model_i, model_ii, paper_model, scene_from_dict,
+                    scene_to_dict, scene_to_toml, simplified_model)
+
+globals().update(TABLE_CLASSES)  # Barrel, RecoilSpring, Absorber, Contact, ...: every element's table
 
 __version__ = "0.1.0"
 
@@ -42,8 +43,7 @@ _LAZY = {
 }
 
 __all__ = [
-    "Absorber", "Barrel", "BatteryStop", "Contact", "Conventions", "Firing", "RecoilDamper", "RecoilSpring",
-    "RecoilStop", "Scene",
+    *TABLE_CLASSES, "Conventions", "Scene",
     "RecoilError", "SceneError", "SimulationError",
     "load_scene", "scene_from_dict", "scene_to_dict", "scene_to_toml",
     "model_i", "model_ii", "paper_model", "simplified_model",

@@ -20,6 +20,10 @@ What it measures (not a timed test: the numbers depend on the machine; the ratio
    its parts), as fractions of one complete run.
 4. **Memory**: RSS over N consecutive runs in this process (Exudyn keeps models alive unless reset;
    ``simulate`` resets them): growth between the first 10 % and the end must be ~0.
+5. **Elements**: the cost of 1, 2, 4 and 8 absorbers (model (ii)'s absorber split into n equal parts of
+   mass m/n, k_r/n, c_r/n, k_c/n: the same motion, so the steps hardly change and the cost is what the
+   elements add), and of capturing the onset rate ``v-`` of the restitution laws inside the solve
+   (``exact-restitution`` against Hunt-Crossley with the lambda it gives at v0: per step of the solve).
 
 Absolute times are printed only in brackets beside the ratios, for context.
 """
@@ -169,6 +173,49 @@ class CompiledDopri5:
         return samples
 
 
+# ------------------------------------------------------------------------------------------------ elements
+
+def split_absorbers(scene, n: int):
+    """The scene's one absorber as n equal absorbers (mass, k_r, c_r and k_c divided by n): the same motion."""
+    from dataclasses import replace
+
+    a = scene.absorber
+    part = replace(a, mass=a.mass / n, stiffness=a.stiffness / n, damping=a.damping / n,
+                   contact=replace(a.contact, stiffness=a.contact.stiffness / n))
+    return scene.with_changes(absorbers=(part,) * n, name=f"{n} absorbers")
+
+
+def restitution_pair(scene):
+    """(exact-restitution e = 0.5, Hunt-Crossley with lambda = chi / v0): the same first impact."""
+    from mbs_models import Contact
+    from mbs_models.elements.contact_laws import exact_restitution_factor
+
+    c = scene.contact
+    chi = exact_restitution_factor(0.5)
+    law = Contact(gap=c.gap, stiffness=c.stiffness, exponent=c.exponent, law="exact-restitution", restitution=0.5)
+    hc = Contact(gap=c.gap, stiffness=c.stiffness, exponent=c.exponent, damping_factor=chi / scene.initial_velocity)
+    return scene.with_changes(contact=law), scene.with_changes(contact=hc)
+
+
+def element_costs(scene, end_time: float, repeats: int) -> tuple[dict, dict]:
+    """Median wall times (s) and steps: ``{n absorbers: (run, solve, steps)}`` and ``{law: (run, solve, steps)}``."""
+    from mbs_models import simulate
+
+    scenes = {n: split_absorbers(scene, n) for n in (1, 2, 4, 8)}
+    law, hc = restitution_pair(scene)
+    laws = {"exact-restitution (captures v-)": law, "hunt-crossley (lambda = chi/v0)": hc}
+    times: dict = {}
+    for _ in range(repeats):
+        for key, s in [*scenes.items(), *laws.items()]:
+            result = simulate(s, end_time, "standard")
+            times.setdefault(key, []).append((result.wall_time, result.timings["solve"], result.steps))
+
+    def med(rows):
+        return tuple(statistics.median(r[i] for r in rows) for i in range(3))
+
+    return {n: med(times[n]) for n in scenes}, {k: med(times[k]) for k in laws}
+
+
 # ------------------------------------------------------------------------------------------------ memory
 
 def rss_bytes() -> int:
@@ -207,6 +254,7 @@ def main(argv=None) -> int:
     parser.add_argument("--memory-end-time", type=float, default=0.05,
                         help="simulated time of each memory-test run in s (default 0.05: the first impact)")
     parser.add_argument("--skip-memory", action="store_true")
+    parser.add_argument("--skip-elements", action="store_true", help="skip the absorber-count and onset-capture costs")
     args = parser.parse_args(argv)
 
     def say(message: str) -> None:
@@ -316,6 +364,12 @@ def main(argv=None) -> int:
     say("import cost (fresh interpreters)")
     imports = import_cost()
 
+    # ---------------------------------------------------------------- elements
+    absorber_costs = law_costs = None
+    if not args.skip_elements and scene.absorber is not None:
+        say("elements: 1, 2, 4, 8 absorbers; onset capture")
+        absorber_costs, law_costs = element_costs(scene, end_time, max(3, args.repeats // 3))
+
     # ---------------------------------------------------------------- memory
     memory = None
     if not args.skip_memory and args.memory_runs > 0:
@@ -376,6 +430,16 @@ def main(argv=None) -> int:
         print(f"   growth from {memory[1][0]} to {memory[-1][0]} runs: {growth / 2**20:+.2f} MiB "
               f"({per_run:+.0f} bytes per run; {'OK, no growth' if abs(growth) < 4 * 2**20 else 'GROWS'})"
               f" [context: {args.memory_runs / memory_wall:.0f} runs/s]")
+    if absorber_costs is not None:
+        base_run, base_solve, base_steps = absorber_costs[1]
+        print("\n5. elements: the same motion split over n absorbers (cost relative to 1 absorber), and the onset capture")
+        for n, (run, solve, steps) in absorber_costs.items():
+            print(f"   {n} absorber{'s' if n > 1 else ' '}: complete run {run / base_run:5.2f}x, solve {solve / base_solve:5.2f}x, "
+                  f"solve per step {solve / steps / (base_solve / base_steps):5.2f}x  [{ms(run)}, {steps} steps]")
+        (law_run, law_solve, law_steps), (hc_run, hc_solve, hc_steps) = law_costs.values()
+        print(f"   onset capture (exact-restitution / Hunt-Crossley at the same first impact): solve per step "
+              f"{law_solve / law_steps / (hc_solve / hc_steps):5.2f}x, complete run {law_run / hc_run:5.2f}x "
+              f"[{law_steps} vs {hc_steps} steps]")
     return 0
 
 

@@ -84,7 +84,7 @@ def bad_scene(request):
 
 
 def v2_scene_dict() -> dict:
-    """A version-2 mapping with every table: two absorbers (Hunt-Crossley, Flores), both end stops."""
+    """A version-2 mapping: two absorbers (Hunt-Crossley on the ground, Flores on the barrel)."""
     return tomllib.loads('''
 version = 2
 name = "every table"
@@ -121,17 +121,6 @@ gap = 0.02
 stiffness = 2.1e8
 exponent = 1.3
 restitution = 0.5
-[recoil_stop]
-position = 0.3
-law = "hunt-crossley"
-stiffness = 1.0e9
-exponent = 1.5
-damping_factor = 0.5
-[battery_stop]
-position = 0.0
-law = "kelvin-voigt"
-stiffness = 5.0e7
-damping = 2.0e5
 ''')
 
 
@@ -165,7 +154,7 @@ DELETED = "<delete>"
 
 @pytest.fixture
 def v2_mapping() -> dict:
-    """A fresh version-2 mapping with every table (see :func:`v2_scene_dict`)."""
+    """A fresh version-2 mapping (see :func:`v2_scene_dict`)."""
     return v2_scene_dict()
 
 

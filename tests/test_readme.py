@@ -46,3 +46,42 @@ def test_readme_guarantees_are_the_tested_tolerances():
         assert (float(energy), float(metric), float(force), float(impact_peak)) == (
             tol["energy"], tol["metric"], tol["force"], tol["impact_peak"]), preset
         assert float(time_value) * (1e-3 if unit == "ms" else 1e-6) == pytest.approx(tol["time"], rel=1e-12), preset
+
+
+def _python_block_after(heading: str) -> str:
+    text = README.read_text()
+    section = text[text.index(heading):]
+    start = section.index("```python\n") + len("```python\n")
+    return section[start:section.index("```", start)]
+
+
+def test_the_building_block_example_runs_and_rebounds_with_the_restitution_asked(capsys):
+    """The README's hand-built Exudyn model with our contact: exact-restitution gives e = 0.6."""
+    exec(compile(_python_block_after("### Building blocks for your own Exudyn scripts"), "README", "exec"), {})
+    out = capsys.readouterr().out
+    restitution = float(re.search(r"restitution (\S+)", out).group(1))
+    assert restitution == pytest.approx(0.6, abs=1e-6)
+    assert float(re.search(r"peak force (\S+) N", out).group(1)) > 0
+
+
+def test_the_version_2_example_runs(capsys):
+    exec(compile(_python_block_after("### Richer mechanisms: scene format version 2"), "README", "exec"), {})
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].startswith("front ") and lines[1].startswith("rear ")
+
+
+def test_the_files_that_know_about_an_effect_are_the_ones_listed():
+    """The README lists, for the end stops, every file that knows about them: no other source, scene or test
+    file of the repository names them (their module, tables or classes)."""
+    import subprocess
+
+    text = README.read_text()
+    block = text[text.index("<!-- effect-files: end_stops -->"):text.index("<!-- /effect-files -->")]
+    listed = set(re.findall(r"^- `([^`]+)`", block, flags=re.M))
+    root = README.parent
+    tracked = subprocess.run(["git", "ls-files", "--cached", "--others", "--exclude-standard"], cwd=root,
+                             capture_output=True, text=True, check=True).stdout.split()
+    names = re.compile(r"end_stops|recoil_stop|battery_stop|RecoilStop|BatteryStop")
+    knowing = {path for path in tracked if path.endswith((".py", ".toml")) and path != "tests/test_readme.py"
+               and names.search((root / path).read_text(errors="replace"))}  # (this checker names them, of course)
+    assert knowing == listed

@@ -7,17 +7,7 @@ Assembly, post-processing, the early stop and the stability checks iterate over 
 effect.  This package finds the tables by itself: adding an effect is adding a module (and its reference
 term in ``validation/reference/terms/`` and its test file).
 
-========================  ==========================================================================
-module                    effect (table)
-========================  ==========================================================================
-:mod:`.barrel`            the recoiling barrel ``[barrel]``
-:mod:`.firing`            the shot's momentum: the initial velocity ``[firing]``
-:mod:`.recoil_spring`     linear spring ground -> barrel ``[recoil_spring]``
-:mod:`.recoil_damper`     asymmetric damper ground -> barrel ``[recoil_damper]``
-:mod:`.absorber`          impact absorbers on their actuators ``[[absorber]]``, with a contact each
-:mod:`.contact_laws`      the contact-law family of every contact (``[absorber.contact]``, the stops)
-:mod:`.end_stops`         the barrel against the ground: ``[recoil_stop]``, ``[battery_stop]``
-========================  ==========================================================================
+The README lists the elements and their tables; ``TABLES`` below is the registry.
 
 Importing this package loads neither Exudyn nor the engine.
 """

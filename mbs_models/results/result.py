@@ -20,7 +20,7 @@ class Impact:
 
     Attributes: ``start`` and ``end`` (s) bound the interval where the contact force is > 0;
     ``peak_force`` (N) is its maximum, reached at ``time_of_peak_force`` (s); ``contact`` names the
-    contact (``"contact"`` for the one absorber's, ``"front_contact"``, ``"recoil_stop"``).
+    contact (``"contact"`` for the one absorber's, ``"front_contact"``, an end stop's name).
     """
 
     start: float
@@ -43,7 +43,7 @@ class Impact:
 class ContactOutput:
     """One contact of a run: its force history (N, at the output times), refined peak and impacts.
 
-    ``element`` is the element it belongs to (the absorber's name, ``recoil_stop``...); ``episodes`` the
+    ``element`` is the element it belongs to (the absorber's name, a stop's...); ``episodes`` the
     number of contact episodes (force > 0), ``impacts`` those above the threshold; ``onsets``: for laws
     that use it, ``(time s, v- m/s)`` at the onset of each episode as captured in the solve.
     ``peak_force``/``impacts`` are None when an early-stopped run did not prove them final.

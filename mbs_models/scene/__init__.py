@@ -10,18 +10,18 @@
 No Exudyn is needed to build, read or write scenes.
 """
 
-from ..elements.absorber import MOUNTS, Absorber
-from ..elements.barrel import Barrel
-from ..elements.contact_laws import CONTACT_LAWS, Contact
-from ..elements.end_stops import BatteryStop, RecoilStop
-from ..elements.firing import Firing
-from ..elements.recoil_damper import RecoilDamper
-from ..elements.recoil_spring import RecoilSpring
+from ..elements import TABLES
+from ..elements.absorber import MOUNTS
+from ..elements.contact_laws import CONTACT_LAWS
 from .container import PAPER_ROUNDED_INITIAL_VELOCITY, Conventions, Scene
 from .io import FORMAT_VERSION, FORMAT_VERSIONS, load_scene, scene_from_dict, scene_to_dict, scene_to_toml
 from .models import model_i, model_ii, paper_model, simplified_model
 
-__all__ = ["Scene", "Conventions", "Barrel", "Firing", "RecoilSpring", "RecoilDamper", "Absorber", "Contact",
-           "RecoilStop", "BatteryStop", "CONTACT_LAWS", "MOUNTS", "PAPER_ROUNDED_INITIAL_VELOCITY",
-           "FORMAT_VERSION", "FORMAT_VERSIONS", "load_scene", "scene_from_dict", "scene_to_dict", "scene_to_toml",
-           "model_i", "model_ii", "paper_model", "simplified_model"]
+#: Every element's table class by its class name (``Barrel``, ``RecoilSpring``, ``Contact``, ...): re-exported
+#: from the element registry, so that a new element is public without being named here.
+TABLE_CLASSES = {cls.__name__: cls for cls in TABLES.values()}
+globals().update(TABLE_CLASSES)
+
+__all__ = ["Scene", "Conventions", *TABLE_CLASSES, "TABLE_CLASSES", "CONTACT_LAWS", "MOUNTS",
+           "PAPER_ROUNDED_INITIAL_VELOCITY", "FORMAT_VERSION", "FORMAT_VERSIONS", "load_scene", "scene_from_dict",
+           "scene_to_dict", "scene_to_toml", "model_i", "model_ii", "paper_model", "simplified_model"]

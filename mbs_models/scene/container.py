@@ -80,7 +80,7 @@ class Scene:
     ``Scene(barrel, recoil_spring, recoil_damper, firing=None, absorber=None, contact=None,
     conventions=None, name="unnamed scene", **tables)``: the first eight are version 1's (one absorber,
     with its ``contact`` given beside it); ``**tables`` are any element tables by their scene attribute
-    (``absorbers=(...)``, ``recoil_stop=...``, ``battery_stop=...``).  A barrel and an initial velocity
+    (``absorbers=(...)``, and any other table by its name).  A barrel and an initial velocity
     (``barrel.initial_velocity`` or a ``firing`` table) are required; every other table is optional and
     an absent one adds nothing to the simulated system.
 
@@ -286,7 +286,7 @@ class Scene:
     def with_changes(self, **changes) -> "Scene":
         """A copy with tables or fields changed.
 
-        Keys: a table (``recoil_spring=RecoilSpring(...)``, ``recoil_stop=None``, ``absorbers=(...)``,
+        Keys: a table (``recoil_spring=RecoilSpring(...)``, ``recoil_damper=None``, ``absorbers=(...)``,
         ``absorber=...`` and ``contact=...`` for the one absorber), ``name``, ``conventions``, or a dotted
         key to one field: ``"contact.gap"``, ``"absorber.mass"`` (the one absorber), ``"absorber.0.mass"``,
         ``"absorber.1.contact.gap"``, ``"recoil_damper.recoil"``, ``"conventions.literal_gap_sign"``.

@@ -10,7 +10,8 @@ the key as it stands in the file (``contact.gap``, ``absorber.1.contact.restitut
   ``[absorber]`` with its ``[contact]`` (Hunt-Crossley), ``[conventions]``.  It keeps loading unchanged.
 * **Version 2** (``version = 2``): every element table of :mod:`mbs_models.elements` is optional but
   ``[barrel]``; absorbers are ``[[absorber]]`` with ``[absorber.contact]`` (a version-1 ``[absorber]`` +
-  ``[contact]`` pair is read as one); ``[recoil_stop]``, ``[battery_stop]``; every contact law.
+  ``[contact]`` pair is read as one); every element table of :data:`mbs_models.elements.TABLES`; every
+  contact law.
 
 :func:`scene_to_toml` writes version 2.
 """

@@ -85,10 +85,15 @@ BAD_STOPS = [
 ]
 
 
+STOP_TABLES = {"recoil_stop": {"position": 0.3, "law": "hunt-crossley", "stiffness": 1.0e9, "exponent": 1.5,
+                               "damping_factor": 0.5},
+               "battery_stop": {"position": 0.0, "law": "kelvin-voigt", "stiffness": 5.0e7, "damping": 2.0e5}}
+
+
 @pytest.mark.parametrize("path, value, key, text", [c[1:] for c in BAD_STOPS], ids=[c[0] for c in BAD_STOPS])
 def test_bad_stop_tables_are_one_line_errors_naming_the_key(bad_input, v2_mapping, changed, path, value, key, text):
-    bad_input(changed(v2_mapping, path, value), key, text)
+    bad_input(changed({**v2_mapping, **STOP_TABLES}, path, value), key, text)
 
 
-def test_stops_need_a_version_2_scene(bad_input, v1_mapping, v2_mapping):
-    bad_input(dict(v1_mapping, recoil_stop=v2_mapping["recoil_stop"]), "recoil_stop", "version-2 scene")
+def test_stops_need_a_version_2_scene(bad_input, v1_mapping):
+    bad_input(dict(v1_mapping, recoil_stop=STOP_TABLES["recoil_stop"]), "recoil_stop", "version-2 scene")

@@ -356,7 +356,8 @@ class Parameters:
 
     @classmethod
     def from_scene(cls, scene: Scene) -> "Parameters":
-        if len(scene.absorbers) > 1 or scene.recoil_stop is not None or scene.battery_stop is not None or \
+        paper_tables = {"barrel", "firing", "recoil_spring", "recoil_damper", "absorber"}
+        if len(scene.absorbers) > 1 or any(key not in paper_tables for key, _ in scene.tables()) or \
                 (scene.contact is not None and scene.contact.law != "hunt-crossley"):
             raise ValueError("the work-precision study covers the paper's models: one Hunt-Crossley absorber, no stops")
         spring, damper = scene.recoil_spring, scene.recoil_damper
