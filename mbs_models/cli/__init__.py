@@ -124,6 +124,24 @@ def _cmd_precision(args) -> int:
     return EXIT_OK
 
 
+def _cmd_contact_laws(args) -> int:
+    from validation.studies.contact_laws import run_study, write
+
+    from ..outputs import prepare_output_dir
+
+    out = prepare_output_dir(args.out)  # bad --out: exit 2 before any work
+    start = time.perf_counter()
+    study = run_study(args.accuracy)
+    write(study, out)
+    if args.json:
+        print(json.dumps(study.to_dict(), indent=2, allow_nan=False))
+    else:
+        print(study.markdown())
+        print(f"wrote contact_laws.png, contact_laws.json and contact_laws.md to {out} in "
+              f"{time.perf_counter() - start:.1f} s (worst engine - closed form: {study.worst_error:.1e})")
+    return EXIT_OK
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="recoil", description="Recoil mechanisms with impact absorbers (Exudyn).")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
@@ -170,6 +188,13 @@ def build_parser() -> argparse.ArgumentParser:
     precision.add_argument("--presets", action="store_true",
                            help="also measure the accuracy presets on the 19 paper cases (presets.md/json)")
     precision.set_defaults(handler=_cmd_precision)
+
+    laws = sub.add_parser("contact-laws", help="the contact-law family on a free impact: restitution achieved vs "
+                                               "requested (closed form and engine) and force-penetration loops")
+    laws.add_argument("--out", default="contact-laws", help="output directory (default ./contact-laws)")
+    laws.add_argument("--accuracy", default="standard", choices=("draft", "standard", "reference"))
+    laws.add_argument("--json", action="store_true", help="print the study as JSON")
+    laws.set_defaults(handler=_cmd_contact_laws)
     return parser
 
 
