@@ -16,6 +16,7 @@ import html
 import math
 import multiprocessing
 import os
+import textwrap
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -464,10 +465,37 @@ Initial state:               x_M = x_m = 0, x_m' = 0, x_M' = v0 = 6.86 kg * 564 
 (F is written here as the force pushing the absorber forward; the paper's F_ct = -F.)"""
 
 
+def _indent(line: str) -> int:
+    return len(line) - len(line.lstrip())
+
+
 def _sketch(func) -> str:
-    doc = func.__doc__ or ""
-    lines = doc.split("::", 1)[-1].split("\n\n")[0] if "::" in doc else ""
-    return lines
+    """The model's ASCII sketch: the literal block after the first line ending in ``::`` of ``func``'s docstring.
+
+    As in reStructuredText, the block is every line after the ``::`` line up to the first non-blank line
+    indented no deeper than that paragraph (blank lines inside the drawing belong to it), dedented as
+    a whole so that the drawing keeps its own indentation.  A ``::`` on the docstring's first line sits
+    at the docstring's margin: the least indentation of the other lines, the closing quotes' line
+    included (``inspect.cleandoc`` leaves that line out, and when every other line is the drawing it is
+    all that marks the margin).  An empty string when there is no such block.
+    """
+    lines = (func.__doc__ or "").expandtabs().splitlines()
+    start = next((i for i, line in enumerate(lines) if line.rstrip().endswith("::")), None)
+    if start is None:
+        return ""
+    if start:
+        paragraph = _indent(lines[start])
+    else:
+        margin_lines = [line for line in lines[1:] if line.strip()]
+        if len(lines) > 1 and not lines[-1].strip():
+            margin_lines.append(lines[-1])
+        paragraph = min(map(_indent, margin_lines), default=0)
+    block: list[str] = []
+    for line in lines[start + 1:]:
+        if line.strip() and _indent(line) <= paragraph:
+            break
+        block.append(line)
+    return textwrap.dedent("\n".join(block)).strip("\n")
 
 
 def render_html(data: dict, pngs: dict[str, bytes]) -> str:

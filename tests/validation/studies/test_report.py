@@ -9,7 +9,7 @@ from html.parser import HTMLParser
 import pytest
 
 from mbs_models.cli import main
-from validation.studies.report import ReportOptions, write_report
+from validation.studies.report import ReportOptions, _sketch, write_report
 
 
 class _Collector(HTMLParser):
@@ -86,3 +86,67 @@ def test_full_report_builds(tmp_path):
     assert all(len(points) == 121 for points in data["sweeps"].values()) and len(data["sweeps"]) == 6
     assert not data["sweep_failures"]
     assert (tmp_path / "report.html").stat().st_size > 100_000
+
+
+# ------------------------------------------------------------------------------------------ model sketches
+@pytest.mark.parametrize("name", ["simplified_model", "model_i", "model_ii"])
+def test_model_sketch_is_the_docstrings_drawing_with_its_indentation(name):
+    from mbs_models.scene import models
+
+    func = getattr(models, name)
+    sketch = _sketch(func).splitlines()
+    assert len(sketch) >= 4, sketch
+    assert any(line.startswith("|") for line in sketch), "the ground line of the drawing, moved to the left edge"
+    assert any(line.startswith(" ") for line in sketch), "the drawing's own indentation is kept"
+    # every line of the sketch is a line of the docstring, all shifted left by the same amount
+    doc = func.__doc__.splitlines()
+    ground = next(line for line in sketch if line.startswith("|"))
+    shift = next(len(d) - len(ground) for d in doc if d.endswith(ground) and not d[:len(d) - len(ground)].strip())
+    assert all(" " * shift + line in doc for line in sketch if line.strip())
+    assert "Parameters" not in "\n".join(sketch)
+
+
+def _first_line_block():
+    """A drawing::
+
+            top
+        |--+
+        |  |
+
+    After the drawing.
+    """
+
+
+def _later_paragraph_block():
+    """Summary.
+
+    The drawing follows::
+
+        a
+          b
+
+        c
+    Text again.
+    """
+
+
+def _drawing_only():
+    """Only a drawing::
+
+            x
+        |---|
+    """
+
+
+def _no_block():
+    """No drawing here: just text."""
+
+
+@pytest.mark.parametrize("func, expected", [
+    (_first_line_block, "    top\n|--+\n|  |"),
+    (_later_paragraph_block, "a\n  b\n\nc"),
+    (_drawing_only, "    x\n|---|"),
+    (_no_block, ""),
+])
+def test_sketch_extraction_follows_the_literal_block(func, expected):
+    assert _sketch(func) == expected
