@@ -415,10 +415,13 @@ body{font-family:system-ui,-apple-system,Segoe UI,Roboto,sans-serif;max-width:11
 color:#222;line-height:1.45}
 h1{font-size:1.6em}h2{border-bottom:2px solid #ddd;padding-bottom:.2em;margin-top:2em}
 table{border-collapse:collapse;margin:1em 0;font-size:.92em}th,td{border:1px solid #ccc;padding:.3em .6em;
-text-align:right}th{background:#f3f3f3}td.l,th.l{text-align:left}pre{background:#f7f7f7;padding:.8em;overflow-x:auto;
-font-size:.85em}figure{margin:1.2em 0}figure img{max-width:100%;border:1px solid #eee}figcaption{font-size:.9em;color:#555}
+text-align:right}th{background:#f3f3f3}td.l,th.l{text-align:left}.scroll{max-width:100%;overflow-x:auto}
+pre{background:#f7f7f7;padding:.8em;max-width:100%;box-sizing:border-box;overflow-x:auto;font-size:.85em}
+pre.wrap{white-space:pre-wrap;overflow-wrap:anywhere}
+figure{margin:1.2em 0}figure img{max-width:100%;border:1px solid #eee}figcaption{font-size:.9em;color:#555}
 .bad{color:#b00020;font-weight:600}.good{color:#1b7f2a;font-weight:600}.note{background:#fff8e1;padding:.6em 1em;
 border-left:4px solid #f0c000}
+@media print{pre{white-space:pre-wrap;overflow-wrap:anywhere}.scroll{overflow:visible}}
 """
 
 
@@ -431,7 +434,8 @@ def _table(headers: list[str], rows: list[list], left: int = 1, table_id: str = 
     head = "".join(f'<th class="l">{_e(h)}</th>' if i < left else f"<th>{_e(h)}</th>" for i, h in enumerate(headers))
     body = "".join("<tr>" + "".join(f'<td class="l">{c}</td>' if i < left else f"<td>{c}</td>"
                                     for i, c in enumerate(row)) + "</tr>" for row in rows)
-    return f"<table{id_attr}><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+    # wide tables scroll inside their own box on a narrow screen instead of widening the page
+    return f"<div class='scroll'><table{id_attr}><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table></div>"
 
 
 def _img(name: str, png: bytes, caption: str) -> str:
@@ -500,8 +504,9 @@ def _sketch(func) -> str:
 
 def render_html(data: dict, pngs: dict[str, bytes]) -> str:
     """The report as one self-contained HTML page."""
-    parts = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>Recoil absorber replication report"
-             f"</title><style>{_CSS}</style></head><body>",
+    parts = ["<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
+             "<meta name='viewport' content='width=device-width, initial-scale=1'>"
+             f"<title>Recoil absorber replication report</title><style>{_CSS}</style></head><body>",
              "<h1>Replication report: recoil mechanism with impact absorbers</h1>",
              "<p>Engine: Exudyn (symbolic user functions, accuracy preset "
              f"<code>{_e(data['options']['accuracy'])}</code>). Independent check: an event-driven scipy solution of "
@@ -598,7 +603,7 @@ def render_html(data: dict, pngs: dict[str, bytes]) -> str:
     calibration = data["calibration"]
     parts.append("<h2 id='calibration'>9. Contact-law calibration on Section 2.2</h2>")
     if calibration is not None:
-        parts.append(f"<pre>{_e(calibration.summary())}</pre>")
+        parts.append(f"<pre class='wrap'>{_e(calibration.summary())}</pre>")  # long lines wrap in the box
         parts.append(_table(["model", "m [kg]", "predicted x_max [m]", "paper [m]", "relative"],
                             [[_e(r["model"]), f"{r['absorber_mass']:g}", f"{r['max_barrel_displacement']:.4f}",
                               _fmt(r["published"]), _pct(r["relative_error"])] for r in data["calibration_table2"]],
