@@ -502,6 +502,12 @@ def _sketch(func) -> str:
     return textwrap.dedent("\n".join(block)).strip("\n")
 
 
+def _contents(sections: list[tuple[str, str]]) -> str:
+    """The table of contents: a numbered link to every section, as (id, title)."""
+    items = "".join(f"<li><a href='#{section_id}'>{_e(title)}</a></li>" for section_id, title in sections)
+    return f"<nav id='contents' aria-label='Contents'><p><b>Contents</b></p><ol>{items}</ol></nav>"
+
+
 def render_html(data: dict, pngs: dict[str, bytes]) -> str:
     """The report as one self-contained HTML page."""
     parts = ["<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
@@ -512,27 +518,35 @@ def render_html(data: dict, pngs: dict[str, bytes]) -> str:
              f"<code>{_e(data['options']['accuracy'])}</code>). Independent check: an event-driven scipy solution of "
              "the same equations (<code>validation.reference</code>). Nothing is tuned to the published numbers; where "
              "we differ, the difference is reported and studied.</p>"]
+    contents_at = len(parts)        # the table of contents goes here, once every section is known
+    sections: list[tuple[str, str]] = []
+
+    def section(section_id: str, title: str) -> str:
+        """The numbered heading of the next section, recorded for the table of contents."""
+        sections.append((section_id, title))
+        return f"<h2 id='{section_id}'>{len(sections)}. {_e(title)}</h2>"
+
     # models
-    parts.append("<h2 id='models'>1. Models and equations</h2>")
+    parts.append(section("models", "Models and equations"))
     for title, func in (("Simplified model (Fig. 1)", _simp_doc), ("Model (i) (Fig. 2)", _model_i_doc),
                         ("Model (ii) (Fig. 3)", _model_ii_doc)):
         parts.append(f"<h3>{_e(title)}</h3><pre>{_e(_sketch(func))}</pre>")
     parts.append(f"<pre>{_e(_EQUATIONS)}</pre>")
     # parameters
-    parts.append("<h2 id='parameters'>2. Parameters</h2>")
+    parts.append(section("parameters", "Parameters"))
     rows = [[_e(p.quantity), _e(p.model), _fmt(p.value, 6), _e(p.unit), _e(p.source), _e(p.note)]
             for p in published_values() if p.model == "all"]
-    parts.append(_table(["quantity", "model", "value", "unit", "source", "note"], rows, left=2, table_id="parameters"))
+    parts.append(_table(["quantity", "model", "value", "unit", "source", "note"], rows, left=2, table_id="tab-parameters"))
     # table 2
     t2 = table2_rows(data)
-    parts.append("<h2 id='table2'>3. Table 2: maximum barrel displacement (gap 0, 10 s)</h2>")
+    parts.append(section("table2", "Table 2: maximum barrel displacement (gap 0, 10 s)"))
     parts.append(_table(["model", "m [kg]", "ours [m]", "reference [m]", "paper [m]", "ours - paper [mm]",
                          "relative", "engine vs reference"],
                         [[_e(r["model"]), f"{r['absorber_mass']:g}", f"{r['engine']:.5f}", f"{r['reference']:.5f}",
                           f"{r['paper']:.4f}", f"{r['difference'] * 1e3:+.2f}", _pct(r["relative_difference"]),
-                          f"{r['engine_vs_reference']:.1e}"] for r in t2], table_id="table2"))
+                          f"{r['engine_vs_reference']:.1e}"] for r in t2], table_id="tab-table2"))
     # sweeps
-    parts.append("<h2 id='sweeps'>4. Gap sweeps (Figs 4 and 5)</h2>")
+    parts.append(section("sweeps", "Gap sweeps (Figs 4 and 5)"))
     gap_step = data["options"]["gap_step"]
     parts.append(f"<p>Gaps 0 to {data['options']['gap_max'] * 1e3:g} mm in {gap_step * 1e3:g} mm steps, engine; "
                  "crosses mark the independent reference.</p>")
@@ -542,16 +556,16 @@ def render_html(data: dict, pngs: dict[str, bytes]) -> str:
     parts.append(_img("fig4_gap_sweep_model_i", pngs["fig4_gap_sweep_model_i"], "Fig. 4 (ours): model (i)"))
     parts.append(_img("fig5_gap_sweep_model_ii", pngs["fig5_gap_sweep_model_ii"], "Fig. 5 (ours): model (ii)"))
     # time histories
-    parts.append("<h2 id='histories'>5. Time histories (Figs 6-8)</h2>")
+    parts.append(section("histories", "Time histories (Figs 6-8)"))
     for mass in data["options"]["masses"]:
         name = f"barrel_displacement_m{mass:g}"
         parts.append(_img(name, pngs[name], f"Barrel displacement, m = {mass:g} kg (paper: Figs 6-8)"))
-    parts.append("<h2 id='contact'>6. Contact force and absorber velocity (Figs 9-11)</h2>")
+    parts.append(section("contact", "Contact force and absorber velocity (Figs 9-11)"))
     s22 = section22_rows(data)
     parts.append(_table(["model", "quantity", "ours", "paper", "unit", "relative", "source"],
                         [[_e(r["model"]), _e(r["quantity"].replace("_", " ")), _fmt(r["ours"], 5), _fmt(r["paper"], 5),
                           _e(r["unit"]), _pct(r["relative_difference"]), _e(r["source"])] for r in s22],
-                        left=2, table_id="section22"))
+                        left=2, table_id="tab-section22"))
     for mass in data["options"]["masses"]:
         for stem, caption in (("contact_force", "Contact force (Fig. 9), with the paper's detail windows"),
                               ("absorber_velocity", "Absorber velocity (Fig. 10)"),
@@ -559,7 +573,7 @@ def render_html(data: dict, pngs: dict[str, bytes]) -> str:
             name = f"{stem}_m{mass:g}"
             parts.append(_img(name, pngs[name], f"{caption}, m = {mass:g} kg"))
     # engine vs reference
-    parts.append("<h2 id='engine-vs-reference'>7. Engine vs independent reference, every case shown</h2>")
+    parts.append(section("engine-vs-reference", "Engine vs independent reference, every case shown"))
     rows = []
     for c in data["comparisons"]:
         err = {x["name"]: x["relative_error"] for x in c["checks"]}
@@ -571,9 +585,9 @@ def render_html(data: dict, pngs: dict[str, bytes]) -> str:
     parts.append("<p>Relative errors; tolerances 1e-4 (displacement), 1e-3 (force, velocity, histories); the "
                  "impact counts must be equal.</p>")
     parts.append(_table(["case", "x_max", "peak force", "v_max absorber", "x_M(t)", "x_m(t)",
-                         "impacts engine / ref.", "verdict"], rows, table_id="engine-vs-reference"))
+                         "impacts engine / ref.", "verdict"], rows, table_id="tab-engine-vs-reference"))
     # conventions
-    parts.append("<h2 id='conventions'>8. Convention study: readings of the paper</h2>")
+    parts.append(section("conventions", "Convention study: readings of the paper"))
     parts.append("<p>Each reading alone (reference values; the engine runs the same scenes). Relative differences "
                  "to the paper; RMS over the 6 Table 2 cells with an absorber and the 6 Section 2.2 numbers.</p>")
     conv_rows = []
@@ -594,31 +608,31 @@ def render_html(data: dict, pngs: dict[str, bytes]) -> str:
     if data["conventions"]:
         parts.append(_table(["reading", "(i) 100", "(i) 500", "(i) 1000", "(ii) 100", "(ii) 500", "(ii) 1000",
                              "F (i)", "v (i)", "RMS", "(ii) x_max at 0/40/80 mm [mm]", "engine vs reference"],
-                            conv_rows, table_id="conventions"))
+                            conv_rows, table_id="tab-conventions"))
         parts.append(_img("conventions_gap_trend", pngs["conventions_gap_trend"],
                           "Model (ii) vs gap under each reading"))
     else:
         parts.append(not_run)
     # calibration
     calibration = data["calibration"]
-    parts.append("<h2 id='calibration'>9. Contact-law calibration on Section 2.2</h2>")
+    parts.append(section("calibration", "Contact-law calibration on Section 2.2"))
     if calibration is not None:
         parts.append(f"<pre class='wrap'>{_e(calibration.summary())}</pre>")  # long lines wrap in the box
         parts.append(_table(["model", "m [kg]", "predicted x_max [m]", "paper [m]", "relative"],
                             [[_e(r["model"]), f"{r['absorber_mass']:g}", f"{r['max_barrel_displacement']:.4f}",
                               _fmt(r["published"]), _pct(r["relative_error"])] for r in data["calibration_table2"]],
-                            table_id="calibration-table2"))
+                            table_id="tab-calibration-table2"))
     else:
         parts.append(not_run)
     # claims
-    parts.append("<h2 id='claims'>10. The paper's qualitative claims</h2>")
+    parts.append(section("claims", "The paper's qualitative claims"))
     parts.append(_table(["claim", "source", "holds?", "evidence"],
                         [[_e(v.claim.text), _e(v.claim.source),
                           "<span class='good'>yes</span>" if v.holds else
                           ("&ndash;" if v.holds is None else "<span class='bad'>no</span>"), _e(v.evidence)]
-                         for v in data.get("claims", [])], left=4, table_id="claims"))
+                         for v in data.get("claims", [])], left=4, table_id="tab-claims"))
     # unreproduced
-    parts.append("<h2 id='unreproduced'>11. Published numbers we cannot reproduce, and the most likely reason</h2>")
+    parts.append(section("unreproduced", "Published numbers we cannot reproduce, and the most likely reason"))
     parts.append(f"<p>Counted as reproduced: within {REPRODUCED_WITHIN * 100:g} % of the published value.</p><ul "
                  "id='unreproduced-list'>")
     for item in data["unreproduced"]:
@@ -629,13 +643,14 @@ def render_html(data: dict, pngs: dict[str, bytes]) -> str:
     parts.append("</ul>")
     timing_rows = [[_e(k), f"{v:.1f} s"] for k, v in data["timings"].items()]
     machine = data.get("machine", {})
-    parts.append("<h2 id='cost'>12. What this report cost</h2>" + _table(["stage", "wall time"], timing_rows)
+    parts.append(section("cost", "What this report cost") + _table(["stage", "wall time"], timing_rows)
                  + (f"<p>{machine.get('cpus')} CPUs, {machine.get('workers')} worker processes, load average "
                     f"{machine.get('load_average_at_start')} at the start (other programs share the CPUs). The gap "
                     "sweeps and the convention study stop each run once its peak metrics are proven final by "
                     "energy bounds (same values as the full 10 s runs); the engine-vs-reference cases and the "
                     "time histories run the full 10 s.</p>" if machine else ""))
     parts.append("</body></html>")
+    parts.insert(contents_at, _contents(sections))
     return "\n".join(parts)
 
 
