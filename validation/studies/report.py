@@ -91,6 +91,9 @@ def _comparison_job(scene: Scene) -> tuple[dict, object]:
     data["model"] = scene.model_label
     data["absorber_mass"] = scene.absorber.mass if scene.absorber else None
     data["gap"] = scene.contact.gap if scene.contact else None
+    # the force on the mount (N, engine only: the reference does not compute it), for Table 2
+    data["engine_peak_support_force"] = comparison.engine.peak_support_force
+    data["engine_time_of_peak_support_force"] = comparison.engine.time_of_peak_support_force
     return data, (comparison.engine if not data["gap"] else None)
 
 
@@ -232,6 +235,39 @@ def _convention_figure(data: dict):
     return fig
 
 
+#: The force on the mount is drawn over the first seconds only (the largest forces come before 1 s).
+MOUNT_FORCE_WINDOW = 2.0   # s
+
+
+def mount_force_mass(data: dict) -> float:
+    """The absorber mass of the force-on-the-mount figure: 1000 kg, the largest mass of the paper."""
+    return max(data["options"]["masses"])
+
+
+def _mount_force_figure(data: dict, mass: float):
+    """The force on the mount (support force, kN) vs time of the three models at one absorber mass, gap 0."""
+    fig, axes = new_figure(1, 1, row_height=3.6)
+    ax = axes[0, 0]
+    runs = data["runs"]
+    for run in (runs[SIMPLIFIED], runs[(MODEL_I, mass)], runs[(MODEL_II, mass)]):
+        model, colour = run.scene.model_label, MODEL_COLOURS.get(run.scene.model_label)
+        shown = run.time <= MOUNT_FORCE_WINDOW
+        label = model
+        if run.peak_support_force is not None:
+            t_peak = run.time_of_peak_support_force
+            label += f": peak |S| {run.peak_support_force / 1e3:.2f} kN at {t_peak:.3f} s"
+            if t_peak <= MOUNT_FORCE_WINDOW:
+                sign = 1.0 if np.interp(t_peak, run.time, run.support_force) >= 0 else -1.0
+                ax.plot([t_peak], [sign * run.peak_support_force / 1e3], "o", color=colour, ms=4)
+        ax.plot(run.time[shown], run.support_force[shown] / 1e3, color=colour, lw=1.2, label=label)
+    ax.axhline(0.0, color="k", lw=0.6)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("support force S [kN]")
+    ax.set_title(f"Force on the mount, m = {mass:g} kg, gap 0 (S > 0: pushed in the recoil direction)", fontsize=11)
+    ax.legend(fontsize=9)
+    return fig
+
+
 #: (file stem, zero-argument figure builder) of the figures being rendered; forked workers read it
 _PENDING_FIGURES: list[tuple[str, Callable]] = []
 
@@ -258,6 +294,8 @@ def figure_builders(data: dict) -> list[tuple[str, Callable]]:
                                                  title=f"Fig. 10: absorber velocity, m = {mass:g} kg")),
             (f"first_impact_{tag}", partial(plot_first_impact, pair, title=f"Fig. 11: first impact, m = {mass:g} kg")),
         ]
+    mass = mount_force_mass(data)
+    builders.append((f"support_force_m{mass:g}", partial(_mount_force_figure, data, mass)))
     if data["conventions"]:
         builders.append(("conventions_gap_trend", partial(_convention_figure, data)))
     return builders
@@ -284,7 +322,8 @@ def make_figures(data: dict, workers: int | None = None) -> dict[str, bytes]:
 
 # --------------------------------------------------------------------------------------------- tables
 def table2_rows(data: dict) -> list[dict]:
-    """Table 2 from the gap-0 comparisons: engine, reference, paper, differences."""
+    """Table 2 from the gap-0 comparisons: engine, reference, paper, differences (m), and the engine's peak
+    force on the mount, ``peak_support_force`` (N, largest |support force|) at ``time_of_peak_support_force`` (s)."""
     published_table = table2()
     by_case = {(c["model"], c["absorber_mass"] or 0.0): c for c in data["comparisons"] if not c["gap"]}
     rows = []
@@ -298,18 +337,63 @@ def table2_rows(data: dict) -> list[dict]:
             rows.append({"model": model, "absorber_mass": mass, "engine": check["engine"],
                          "reference": check["reference"], "engine_vs_reference": check["relative_error"],
                          "paper": paper, "difference": check["engine"] - paper,
-                         "relative_difference": (check["engine"] - paper) / paper})
+                         "relative_difference": (check["engine"] - paper) / paper,
+                         "peak_support_force": case.get("engine_peak_support_force"),
+                         "time_of_peak_support_force": case.get("engine_time_of_peak_support_force")})
     return rows
 
 
+def _kn(force: float | None) -> str:
+    """A force in N written in kN (a dash when there is none)."""
+    return "-" if force is None else f"{force / 1e3:.2f}"
+
+
 def table2_markdown(rows: list[dict]) -> str:
-    lines = ["| model | m [kg] | ours [m] | paper [m] | ours - paper [mm] | rel. diff. | engine vs reference |",
-             "|---|---:|---:|---:|---:|---:|---:|"]
+    lines = [("| model | m [kg] | ours [m] | paper [m] | ours - paper [mm] | rel. diff. | engine vs reference | "
+              "peak support force [kN] |"),
+             "|---|---:|---:|---:|---:|---:|---:|---:|"]
     for r in rows:
         lines.append(f"| {r['model']} | {r['absorber_mass']:g} | {r['engine']:.4f} | {r['paper']:.4f} | "
                      f"{r['difference'] * 1e3:+.2f} | {r['relative_difference'] * 100:+.2f} % | "
-                     f"{r['engine_vs_reference']:.1e} |")
+                     f"{r['engine_vs_reference']:.1e} | {_kn(r['peak_support_force'])} |")
     return "\n".join(lines) + "\n"
+
+
+#: Units of the numbers in :func:`table2_rows` (written beside them in ``table2.json``).
+TABLE2_UNITS = {"absorber_mass": "kg", "engine": "m", "reference": "m", "paper": "m", "difference": "m",
+                "relative_difference": "1", "engine_vs_reference": "1", "peak_support_force": "N",
+                "time_of_peak_support_force": "s"}
+
+
+def mount_force_sentences(rows: list[dict]) -> list[str]:
+    """What Table 2's rows say about the force on the mount: at each absorber mass with the three models,
+    which model moderates it most (the lowest peak support force) and how that goes with the recoil length
+    (the lowest maximum barrel displacement)."""
+    by_case = {(r["model"], r["absorber_mass"]): r for r in rows if r.get("peak_support_force") is not None}
+    sentences, lowest_models, trade_offs = [], set(), []
+    for mass in TABLE2_MASSES:
+        cases = [by_case.get((model, mass)) for model in (SIMPLIFIED, MODEL_I, MODEL_II)]
+        if None in cases:
+            continue
+        lowest = min(cases, key=lambda r: r["peak_support_force"])
+        shortest = min(cases, key=lambda r: r["engine"])
+        others = ", ".join(f"{r['model']} {_kn(r['peak_support_force'])} kN" for r in cases if r is not lowest)
+        text = (f"m = {mass:g} kg: {lowest['model']} moderates the force on the mount most, "
+                f"{_kn(lowest['peak_support_force'])} kN ({others})")
+        if shortest is lowest:
+            text += f", and also recoils least ({shortest['engine']:.4f} m)."
+        else:
+            excess = shortest["peak_support_force"] / lowest["peak_support_force"] - 1
+            text += (f"; {shortest['model']} recoils least, {shortest['engine']:.4f} m against "
+                     f"{lowest['engine']:.4f} m, but pushes {excess * 100:.1f} % harder on the mount.")
+        sentences.append(text)
+        lowest_models.add(lowest["model"])
+        trade_offs.append(shortest is not lowest)
+    if len(sentences) > 1 and len(lowest_models) == 1:
+        text = f"At every absorber mass, {next(iter(lowest_models))} moderates the force on the mount most"
+        sentences.append(text + ("; the shortest recoil comes with a higher force on the mount: a lower displacement "
+                                 "is not a lower load on the support." if all(trade_offs) else "."))
+    return sentences
 
 
 def section22_rows(data: dict) -> list[dict]:
@@ -544,15 +628,26 @@ def render_html(data: dict, pngs: dict[str, bytes]) -> str:
     parts.append(section("parameters", "Parameters"))
     rows = [[_e(p.quantity), _e(p.model), _fmt(p.value, 6), _e(p.unit), _e(p.source), _e(p.note)]
             for p in published_values() if p.model == "all"]
-    parts.append(_table(["quantity", "model", "value", "unit", "source", "note"], rows, left=2, table_id="tab-parameters"))
+    parts.append(_table(["quantity", "model", "value", "unit", "source", "note"], rows, left=2,
+                        table_id="tab-parameters"))
     # table 2
     t2 = table2_rows(data)
-    parts.append(section("table2", "Table 2: maximum barrel displacement (gap 0, 10 s)"))
+    parts.append(section("table2", "Table 2: maximum barrel displacement and force on the mount (gap 0, 10 s)"))
     parts.append(_table(["model", "m [kg]", "ours [m]", "reference [m]", "paper [m]", "ours - paper [mm]",
-                         "relative", "engine vs reference"],
+                         "relative", "engine vs reference", "peak support force [kN]"],
                         [[_e(r["model"]), f"{r['absorber_mass']:g}", f"{r['engine']:.5f}", f"{r['reference']:.5f}",
                           f"{r['paper']:.4f}", f"{r['difference'] * 1e3:+.2f}", _pct(r["relative_difference"]),
-                          f"{r['engine_vs_reference']:.1e}"] for r in t2], table_id="tab-table2"))
+                          f"{r['engine_vs_reference']:.1e}", _kn(r["peak_support_force"])] for r in t2],
+                        table_id="tab-table2"))
+    parts.append("<p id='mount-force'>Peak support force: the largest magnitude of the force on the mount (what "
+                 "the recoil spring and damper, and in model (ii) the absorber's spring and damper, transmit to the "
+                 "ground) over the 10 s, engine. Moderating it is what a recoil mechanism is for; the paper does not "
+                 "report it.</p><ul id='mount-force-verdict'>"
+                 + "".join(f"<li>{_e(sentence)}</li>" for sentence in mount_force_sentences(t2)) + "</ul>")
+    mass = mount_force_mass(data)
+    name = f"support_force_m{mass:g}"
+    parts.append(_img(name, pngs[name], f"Force on the mount: support force of the three models, m = {mass:g} kg, "
+                                        f"gap 0, first {MOUNT_FORCE_WINDOW:g} s"))
     # sweeps
     parts.append(section("sweeps", "Gap sweeps (Figs 4 and 5)"))
     gap_step = data["options"]["gap_step"]
@@ -707,9 +802,12 @@ def write_report(out: str | Path, options: ReportOptions = ReportOptions(), prog
     for name, png in pngs.items():
         atomic_write_bytes(out / f"{name}.png", png)
     rows = table2_rows(data)
-    atomic_write_text(out / "table2.md", "# Table 2: maximum barrel displacement, gap 0, 10 s\n\n"
-                      "Ours = Exudyn engine (standard); reference = independent scipy solution.\n\n" + table2_markdown(rows))
-    atomic_write_json(out / "table2.json", {"rows": rows})
+    atomic_write_text(out / "table2.md", "# Table 2: maximum barrel displacement and force on the mount, "
+                      "gap 0, 10 s\n\n"
+                      "Ours = Exudyn engine (standard); reference = independent scipy solution; peak support force "
+                      "= largest |force on the mount| (engine).\n\n" + table2_markdown(rows) + "\n"
+                      + "".join(f"- {sentence}\n" for sentence in mount_force_sentences(rows)))
+    atomic_write_json(out / "table2.json", {"rows": rows, "units": TABLE2_UNITS})
     data["timings"]["total"] = time.perf_counter() - start
     atomic_write_json(out / "results.json", results_json(data))
     atomic_write_text(out / "report.html", render_html(data, pngs))

@@ -44,7 +44,8 @@ def test_report_html_has_every_section_figure_and_table(report_dir):
     for table in ("parameters", "table2", "section22", "engine-vs-reference", "conventions", "calibration-table2",
                   "claims"):
         assert f"tab-{table}" in parser.ids, table
-    expected_figures = {"fig4_gap_sweep_model_i", "fig5_gap_sweep_model_ii", "conventions_gap_trend"} | {
+    expected_figures = {"fig4_gap_sweep_model_i", "fig5_gap_sweep_model_ii", "conventions_gap_trend",
+                        "support_force_m1000"} | {
         f"{stem}_m{m}" for stem in ("barrel_displacement", "contact_force", "absorber_velocity", "first_impact")
         for m in (100, 500, 1000)}
     assert {f"fig-{name}" for name in expected_figures} <= parser.ids
@@ -86,6 +87,44 @@ def test_full_report_builds(tmp_path):
     assert all(len(points) == 121 for points in data["sweeps"].values()) and len(data["sweeps"]) == 6
     assert not data["sweep_failures"]
     assert (tmp_path / "report.html").stat().st_size > 100_000
+
+
+# ----------------------------------------------------------------------------------- force on the mount
+#: Section 2.1 of the paper, for bounds on the force on the mount that do not come from the code under test.
+RECOIL_STIFFNESS = 27500.0                    # k, N/m
+RECOIL_DAMPING = 6239.0                       # c while x_M' > 0, N s/m
+INITIAL_VELOCITY = 6.86 * 564.0 / 5600.0      # v0 = m_p v_p / M, m/s
+
+
+def _markdown_rows(text: str) -> list[dict]:
+    lines = [line for line in text.splitlines() if line.startswith("|") and not line.startswith("|---")]
+    headers = [cell.strip() for cell in lines[0].strip("|").split("|")]
+    return [dict(zip(headers, (cell.strip() for cell in line.strip("|").split("|")))) for line in lines[1:]]
+
+
+def test_table2_gives_the_force_on_the_mount(report_dir):
+    table = json.loads((report_dir / "table2.json").read_text())
+    assert table["units"]["peak_support_force"] == "N" and table["units"]["engine"] == "m"
+    rows = {(r["model"], r["absorber_mass"]): r for r in table["rows"]}
+    assert len(rows) == 9
+    for (model, mass), r in rows.items():
+        force = r["peak_support_force"]
+        # at t = 0 the barrel moves at v0 and nothing else touches the ground: the mount feels c v0
+        assert force >= RECOIL_DAMPING * INITIAL_VELOCITY * (1 - 1e-6), (model, mass)
+        if model != "model (ii)":  # the barrel stops at its largest displacement: the recoil spring alone, k x_max
+            assert force >= RECOIL_STIFFNESS * r["engine"] * (1 - 1e-6), (model, mass)
+        assert 0.0 <= r["time_of_peak_support_force"] <= 10.0
+    assert len({rows[("simplified", m)]["peak_support_force"] for m in (100.0, 500.0, 1000.0)}) == 1
+    # table2.md: the same numbers, in kN
+    for row in _markdown_rows((report_dir / "table2.md").read_text()):
+        expected = rows[(row["model"], float(row["m [kg]"]))]["peak_support_force"] / 1e3
+        assert float(row["peak support force [kN]"]) == pytest.approx(expected, abs=0.005)
+    # results.json: the same rows, from the same gap-0 runs as the time histories
+    results = json.loads((report_dir / "results.json").read_text())
+    assert [r["peak_support_force"] for r in results["table2"]] == [r["peak_support_force"] for r in table["rows"]]
+    for (model, mass), r in rows.items():
+        key = model if model == "simplified" else f"{model}:{mass:g}"
+        assert results["time_histories"][key]["peak_support_force"] == r["peak_support_force"]
 
 
 # ------------------------------------------------------------------------------------------ model sketches
