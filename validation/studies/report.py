@@ -349,13 +349,13 @@ def _kn(force: float | None) -> str:
 
 
 def table2_markdown(rows: list[dict]) -> str:
-    lines = [("| model | m [kg] | ours [m] | paper [m] | ours - paper [mm] | rel. diff. | engine vs reference | "
-              "peak support force [kN] |"),
+    lines = [("| model | m [kg] | ours [m] | peak support force [kN] | paper [m] | ours - paper [mm] | rel. diff. | "
+              "engine vs reference |"),
              "|---|---:|---:|---:|---:|---:|---:|---:|"]
     for r in rows:
-        lines.append(f"| {r['model']} | {r['absorber_mass']:g} | {r['engine']:.4f} | {r['paper']:.4f} | "
-                     f"{r['difference'] * 1e3:+.2f} | {r['relative_difference'] * 100:+.2f} % | "
-                     f"{r['engine_vs_reference']:.1e} | {_kn(r['peak_support_force'])} |")
+        lines.append(f"| {r['model']} | {r['absorber_mass']:g} | {r['engine']:.4f} | {_kn(r['peak_support_force'])} | "
+                     f"{r['paper']:.4f} | {r['difference'] * 1e3:+.2f} | {r['relative_difference'] * 100:+.2f} % | "
+                     f"{r['engine_vs_reference']:.1e} |")
     return "\n".join(lines) + "\n"
 
 
@@ -511,8 +511,8 @@ text-align:right}th{background:#f3f3f3}td.l,th.l{text-align:left}.scroll{max-wid
 pre{background:#f7f7f7;padding:.8em;max-width:100%;box-sizing:border-box;overflow-x:auto;font-size:.85em}
 pre.wrap{white-space:pre-wrap;overflow-wrap:anywhere}
 figure{margin:1.2em 0}figure img{max-width:100%;border:1px solid #eee}figcaption{font-size:.9em;color:#555}
-.bad{color:#b00020;font-weight:600}.good{color:#1b7f2a;font-weight:600}.note{background:#fff8e1;padding:.6em 1em;
-border-left:4px solid #f0c000}
+.bad{color:#b00020;font-weight:600}.good{color:#1b7f2a;font-weight:600}.bad,.good{white-space:nowrap}
+.note{background:#fff8e1;padding:.6em 1em;border-left:4px solid #f0c000}
 @media print{pre{white-space:pre-wrap;overflow-wrap:anywhere}.scroll{overflow:visible}}
 """
 
@@ -633,11 +633,11 @@ def render_html(data: dict, pngs: dict[str, bytes]) -> str:
     # table 2
     t2 = table2_rows(data)
     parts.append(section("table2", "Table 2: maximum barrel displacement and force on the mount (gap 0, 10 s)"))
-    parts.append(_table(["model", "m [kg]", "ours [m]", "reference [m]", "paper [m]", "ours - paper [mm]",
-                         "relative", "engine vs reference", "peak support force [kN]"],
-                        [[_e(r["model"]), f"{r['absorber_mass']:g}", f"{r['engine']:.5f}", f"{r['reference']:.5f}",
-                          f"{r['paper']:.4f}", f"{r['difference'] * 1e3:+.2f}", _pct(r["relative_difference"]),
-                          f"{r['engine_vs_reference']:.1e}", _kn(r["peak_support_force"])] for r in t2],
+    parts.append(_table(["model", "m [kg]", "ours [m]", "peak support force [kN]", "reference [m]", "paper [m]",
+                         "ours - paper [mm]", "relative", "engine vs reference"],
+                        [[_e(r["model"]), f"{r['absorber_mass']:g}", f"{r['engine']:.5f}", _kn(r["peak_support_force"]),
+                          f"{r['reference']:.5f}", f"{r['paper']:.4f}", f"{r['difference'] * 1e3:+.2f}",
+                          _pct(r["relative_difference"]), f"{r['engine_vs_reference']:.1e}"] for r in t2],
                         table_id="tab-table2"))
     parts.append("<p id='mount-force'>Peak support force: the largest magnitude of the force on the mount (what "
                  "the recoil spring and damper, and in model (ii) the absorber's spring and damper, transmit to the "
