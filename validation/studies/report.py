@@ -16,6 +16,7 @@ import html
 import math
 import multiprocessing
 import os
+import textwrap
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -66,8 +67,8 @@ class ReportOptions:
     @classmethod
     def reduced(cls, **changes) -> "ReportOptions":
         """A small but complete report (every section and figure) for tests."""
-        base = dict(gap_step=0.02, comparison_gaps=(0.0,), convention_labels=("default (DESIGN.md)",
-                                                                                     "literal_gap_sign"),
+        default = next(label for label, conventions in CONVENTION_CASES if not conventions.active)
+        base = dict(gap_step=0.02, comparison_gaps=(0.0,), convention_labels=(default, "literal_gap_sign"),
                     calibration_parameters=("stiffness", "damping_factor"), calibration_bounds={})
         base.update(changes)
         return cls(**base)
@@ -90,6 +91,9 @@ def _comparison_job(scene: Scene) -> tuple[dict, object]:
     data["model"] = scene.model_label
     data["absorber_mass"] = scene.absorber.mass if scene.absorber else None
     data["gap"] = scene.contact.gap if scene.contact else None
+    # the force on the mount (N, engine only: the reference does not compute it), for Table 2
+    data["engine_peak_support_force"] = comparison.engine.peak_support_force
+    data["engine_time_of_peak_support_force"] = comparison.engine.time_of_peak_support_force
     return data, (comparison.engine if not data["gap"] else None)
 
 
@@ -222,12 +226,45 @@ def _convention_figure(data: dict):
     fig, axes = new_figure(1, 1, row_height=3.6)
     ax = axes[0, 0]
     for row in data["conventions"]:
-        ax.plot(np.array(TREND_GAPS) * 1e3, np.array(row.trend()) * 1e3, "o-", label=row.label)
+        ax.plot(np.array(TREND_GAPS) * 1e3, np.array(row.trend()) * 1e3, "o-", label=reading_name(row))
     ax.set_xlabel("gap [mm]")
     ax.set_ylabel("max barrel displacement [mm]")
     ax.set_title("Model (ii), m = 1000 kg: each reading of the paper vs gap (Fig. 5 claims a maximum at gap 0)",
                  fontsize=10)
     ax.legend(fontsize=8)
+    return fig
+
+
+#: The force on the mount is drawn over the first seconds only (the largest forces come before 1 s).
+MOUNT_FORCE_WINDOW = 2.0   # s
+
+
+def mount_force_mass(data: dict) -> float:
+    """The absorber mass of the force-on-the-mount figure: 1000 kg, the largest mass of the paper."""
+    return max(data["options"]["masses"])
+
+
+def _mount_force_figure(data: dict, mass: float):
+    """The force on the mount (support force, kN) vs time of the three models at one absorber mass, gap 0."""
+    fig, axes = new_figure(1, 1, row_height=3.6)
+    ax = axes[0, 0]
+    runs = data["runs"]
+    for run in (runs[SIMPLIFIED], runs[(MODEL_I, mass)], runs[(MODEL_II, mass)]):
+        model, colour = run.scene.model_label, MODEL_COLOURS.get(run.scene.model_label)
+        shown = run.time <= MOUNT_FORCE_WINDOW
+        label = model
+        if run.peak_support_force is not None:
+            t_peak = run.time_of_peak_support_force
+            label += f": peak |S| {run.peak_support_force / 1e3:.2f} kN at {t_peak:.3f} s"
+            if t_peak <= MOUNT_FORCE_WINDOW:
+                sign = 1.0 if np.interp(t_peak, run.time, run.support_force) >= 0 else -1.0
+                ax.plot([t_peak], [sign * run.peak_support_force / 1e3], "o", color=colour, ms=4)
+        ax.plot(run.time[shown], run.support_force[shown] / 1e3, color=colour, lw=1.2, label=label)
+    ax.axhline(0.0, color="k", lw=0.6)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("support force S [kN]")
+    ax.set_title(f"Force on the mount, m = {mass:g} kg, gap 0 (S > 0: pushed in the recoil direction)", fontsize=11)
+    ax.legend(fontsize=9)
     return fig
 
 
@@ -257,6 +294,8 @@ def figure_builders(data: dict) -> list[tuple[str, Callable]]:
                                                  title=f"Fig. 10: absorber velocity, m = {mass:g} kg")),
             (f"first_impact_{tag}", partial(plot_first_impact, pair, title=f"Fig. 11: first impact, m = {mass:g} kg")),
         ]
+    mass = mount_force_mass(data)
+    builders.append((f"support_force_m{mass:g}", partial(_mount_force_figure, data, mass)))
     if data["conventions"]:
         builders.append(("conventions_gap_trend", partial(_convention_figure, data)))
     return builders
@@ -283,7 +322,8 @@ def make_figures(data: dict, workers: int | None = None) -> dict[str, bytes]:
 
 # --------------------------------------------------------------------------------------------- tables
 def table2_rows(data: dict) -> list[dict]:
-    """Table 2 from the gap-0 comparisons: engine, reference, paper, differences."""
+    """Table 2 from the gap-0 comparisons: engine, reference, paper, differences (m), and the engine's peak
+    force on the mount, ``peak_support_force`` (N, largest |support force|) at ``time_of_peak_support_force`` (s)."""
     published_table = table2()
     by_case = {(c["model"], c["absorber_mass"] or 0.0): c for c in data["comparisons"] if not c["gap"]}
     rows = []
@@ -297,18 +337,63 @@ def table2_rows(data: dict) -> list[dict]:
             rows.append({"model": model, "absorber_mass": mass, "engine": check["engine"],
                          "reference": check["reference"], "engine_vs_reference": check["relative_error"],
                          "paper": paper, "difference": check["engine"] - paper,
-                         "relative_difference": (check["engine"] - paper) / paper})
+                         "relative_difference": (check["engine"] - paper) / paper,
+                         "peak_support_force": case.get("engine_peak_support_force"),
+                         "time_of_peak_support_force": case.get("engine_time_of_peak_support_force")})
     return rows
 
 
+def _kn(force: float | None) -> str:
+    """A force in N written in kN (a dash when there is none)."""
+    return "-" if force is None else f"{force / 1e3:.2f}"
+
+
 def table2_markdown(rows: list[dict]) -> str:
-    lines = ["| model | m [kg] | ours [m] | paper [m] | ours - paper [mm] | rel. diff. | engine vs reference |",
-             "|---|---:|---:|---:|---:|---:|---:|"]
+    lines = [("| model | m [kg] | ours [m] | peak support force [kN] | paper [m] | ours - paper [mm] | rel. diff. | "
+              "engine vs reference |"),
+             "|---|---:|---:|---:|---:|---:|---:|---:|"]
     for r in rows:
-        lines.append(f"| {r['model']} | {r['absorber_mass']:g} | {r['engine']:.4f} | {r['paper']:.4f} | "
-                     f"{r['difference'] * 1e3:+.2f} | {r['relative_difference'] * 100:+.2f} % | "
+        lines.append(f"| {r['model']} | {r['absorber_mass']:g} | {r['engine']:.4f} | {_kn(r['peak_support_force'])} | "
+                     f"{r['paper']:.4f} | {r['difference'] * 1e3:+.2f} | {r['relative_difference'] * 100:+.2f} % | "
                      f"{r['engine_vs_reference']:.1e} |")
     return "\n".join(lines) + "\n"
+
+
+#: Units of the numbers in :func:`table2_rows` (written beside them in ``table2.json``).
+TABLE2_UNITS = {"absorber_mass": "kg", "engine": "m", "reference": "m", "paper": "m", "difference": "m",
+                "relative_difference": "1", "engine_vs_reference": "1", "peak_support_force": "N",
+                "time_of_peak_support_force": "s"}
+
+
+def mount_force_sentences(rows: list[dict]) -> list[str]:
+    """What Table 2's rows say about the force on the mount: at each absorber mass with the three models,
+    which model moderates it most (the lowest peak support force) and how that goes with the recoil length
+    (the lowest maximum barrel displacement)."""
+    by_case = {(r["model"], r["absorber_mass"]): r for r in rows if r.get("peak_support_force") is not None}
+    sentences, lowest_models, trade_offs = [], set(), []
+    for mass in TABLE2_MASSES:
+        cases = [by_case.get((model, mass)) for model in (SIMPLIFIED, MODEL_I, MODEL_II)]
+        if None in cases:
+            continue
+        lowest = min(cases, key=lambda r: r["peak_support_force"])
+        shortest = min(cases, key=lambda r: r["engine"])
+        others = ", ".join(f"{r['model']} {_kn(r['peak_support_force'])} kN" for r in cases if r is not lowest)
+        text = (f"m = {mass:g} kg: {lowest['model']} moderates the force on the mount most, "
+                f"{_kn(lowest['peak_support_force'])} kN ({others})")
+        if shortest is lowest:
+            text += f", and also recoils least ({shortest['engine']:.4f} m)."
+        else:
+            excess = shortest["peak_support_force"] / lowest["peak_support_force"] - 1
+            text += (f"; {shortest['model']} recoils least, {shortest['engine']:.4f} m against "
+                     f"{lowest['engine']:.4f} m, but pushes {excess * 100:.1f} % harder on the mount.")
+        sentences.append(text)
+        lowest_models.add(lowest["model"])
+        trade_offs.append(shortest is not lowest)
+    if len(sentences) > 1 and len(lowest_models) == 1:
+        text = f"At every absorber mass, {next(iter(lowest_models))} moderates the force on the mount most"
+        sentences.append(text + ("; the shortest recoil comes with a higher force on the mount: a lower displacement "
+                                 "is not a lower load on the support." if all(trade_offs) else "."))
+    return sentences
 
 
 def section22_rows(data: dict) -> list[dict]:
@@ -327,6 +412,13 @@ def section22_rows(data: dict) -> list[dict]:
     return rows
 
 
+def reading_name(row) -> str:
+    """The name the report gives a reading of the paper (a row of the convention study): ``"default"`` for
+    the reading with no flag -- its label in the study's data, :data:`CONVENTION_CASES`, names a design
+    document the report's reader does not have -- and the flag's name otherwise."""
+    return "default" if not row.conventions.active else row.label
+
+
 _NOT_STUDIED = ("the readings of the paper and the contact-law calibration were not computed in this run "
                 "(recoil paper --reproduce-only); the full report studies them")
 
@@ -343,13 +435,14 @@ def unreproduced(data: dict) -> list[dict]:
         """Text about the reading closest to the paper, and whether it reproduces the number."""
         if not conventions:
             return _NOT_STUDIED, True
-        err, label, signed, rms = min((abs(errors_of(row)), row.label, errors_of(row), row.rms_error())
-                                      for row in conventions)
-        text = f"the closest reading of the paper is '{label}' at {signed * 100:+.1f} %"
-        if err <= REPRODUCED_WITHIN and label != "default (DESIGN.md)" and default_rms is not None:
+        closest = min(conventions, key=lambda row: (abs(errors_of(row)), row.label))
+        signed = errors_of(closest)
+        err = abs(signed)
+        text = f"the closest reading of the paper is '{reading_name(closest)}' at {signed * 100:+.1f} %"
+        if err <= REPRODUCED_WITHIN and closest.conventions.active and default_rms is not None:
             text += (f", which reproduces this number but moves the others away (RMS over all published numbers "
-                     f"{rms * 100:.1f} % against {default_rms * 100:.1f} % by default): the paper may have used "
-                     "that reading for this case only")
+                     f"{closest.rms_error() * 100:.1f} % against {default_rms * 100:.1f} % by default): the paper "
+                     "may have used that reading for this case only")
         return text, err <= REPRODUCED_WITHIN
 
     for row in table2_rows(data):
@@ -414,10 +507,13 @@ body{font-family:system-ui,-apple-system,Segoe UI,Roboto,sans-serif;max-width:11
 color:#222;line-height:1.45}
 h1{font-size:1.6em}h2{border-bottom:2px solid #ddd;padding-bottom:.2em;margin-top:2em}
 table{border-collapse:collapse;margin:1em 0;font-size:.92em}th,td{border:1px solid #ccc;padding:.3em .6em;
-text-align:right}th{background:#f3f3f3}td.l,th.l{text-align:left}pre{background:#f7f7f7;padding:.8em;overflow-x:auto;
-font-size:.85em}figure{margin:1.2em 0}figure img{max-width:100%;border:1px solid #eee}figcaption{font-size:.9em;color:#555}
-.bad{color:#b00020;font-weight:600}.good{color:#1b7f2a;font-weight:600}.note{background:#fff8e1;padding:.6em 1em;
-border-left:4px solid #f0c000}
+text-align:right}th{background:#f3f3f3}td.l,th.l{text-align:left}.scroll{max-width:100%;overflow-x:auto}
+pre{background:#f7f7f7;padding:.8em;max-width:100%;box-sizing:border-box;overflow-x:auto;font-size:.85em}
+pre.wrap{white-space:pre-wrap;overflow-wrap:anywhere}
+figure{margin:1.2em 0}figure img{max-width:100%;border:1px solid #eee}figcaption{font-size:.9em;color:#555}
+.bad{color:#b00020;font-weight:600}.good{color:#1b7f2a;font-weight:600}.bad,.good{white-space:nowrap}
+.note{background:#fff8e1;padding:.6em 1em;border-left:4px solid #f0c000}
+@media print{pre{white-space:pre-wrap;overflow-wrap:anywhere}.scroll{overflow:visible}}
 """
 
 
@@ -430,7 +526,8 @@ def _table(headers: list[str], rows: list[list], left: int = 1, table_id: str = 
     head = "".join(f'<th class="l">{_e(h)}</th>' if i < left else f"<th>{_e(h)}</th>" for i, h in enumerate(headers))
     body = "".join("<tr>" + "".join(f'<td class="l">{c}</td>' if i < left else f"<td>{c}</td>"
                                     for i, c in enumerate(row)) + "</tr>" for row in rows)
-    return f"<table{id_attr}><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+    # wide tables scroll inside their own box on a narrow screen instead of widening the page
+    return f"<div class='scroll'><table{id_attr}><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table></div>"
 
 
 def _img(name: str, png: bytes, caption: str) -> str:
@@ -459,47 +556,100 @@ Model (i), Eqs. (4)-(5):     M x_M'' + k x_M + c x_M' + c_r (x_M' - x_m') + k_r 
                              m x_m'' - c_r (x_M' - x_m') - k_r (x_M - x_m) - F = 0
 Model (ii), Eqs. (7)-(8):    M x_M'' + k x_M + c x_M' + F = 0
                              m x_m'' + k_r x_m + c_r x_m' - F = 0
-Contact, Eq. (6) (DESIGN):   p = (x_M - x_m) - gap,  F = k_c p^n_c (1 + lambda p') for p > 0, F >= 0 (never pulls)
+Contact, Eq. (6), our signs: p = (x_M - x_m) - gap,  F = k_c p^n_c (1 + lambda p') for p > 0, F >= 0 (never pulls)
 Initial state:               x_M = x_m = 0, x_m' = 0, x_M' = v0 = 6.86 kg * 564 m/s / 5600 kg = 0.6909 m/s
 (F is written here as the force pushing the absorber forward; the paper's F_ct = -F.)"""
 
 
+def _indent(line: str) -> int:
+    return len(line) - len(line.lstrip())
+
+
 def _sketch(func) -> str:
-    doc = func.__doc__ or ""
-    lines = doc.split("::", 1)[-1].split("\n\n")[0] if "::" in doc else ""
-    return lines
+    """The model's ASCII sketch: the literal block after the first line ending in ``::`` of ``func``'s docstring.
+
+    As in reStructuredText, the block is every line after the ``::`` line up to the first non-blank line
+    indented no deeper than that paragraph (blank lines inside the drawing belong to it), dedented as
+    a whole so that the drawing keeps its own indentation.  A ``::`` on the docstring's first line sits
+    at the docstring's margin: the least indentation of the other lines, the closing quotes' line
+    included (``inspect.cleandoc`` leaves that line out, and when every other line is the drawing it is
+    all that marks the margin).  An empty string when there is no such block.
+    """
+    lines = (func.__doc__ or "").expandtabs().splitlines()
+    start = next((i for i, line in enumerate(lines) if line.rstrip().endswith("::")), None)
+    if start is None:
+        return ""
+    if start:
+        paragraph = _indent(lines[start])
+    else:
+        margin_lines = [line for line in lines[1:] if line.strip()]
+        if len(lines) > 1 and not lines[-1].strip():
+            margin_lines.append(lines[-1])
+        paragraph = min(map(_indent, margin_lines), default=0)
+    block: list[str] = []
+    for line in lines[start + 1:]:
+        if line.strip() and _indent(line) <= paragraph:
+            break
+        block.append(line)
+    return textwrap.dedent("\n".join(block)).strip("\n")
+
+
+def _contents(sections: list[tuple[str, str]]) -> str:
+    """The table of contents: a numbered link to every section, as (id, title)."""
+    items = "".join(f"<li><a href='#{section_id}'>{_e(title)}</a></li>" for section_id, title in sections)
+    return f"<nav id='contents' aria-label='Contents'><p><b>Contents</b></p><ol>{items}</ol></nav>"
 
 
 def render_html(data: dict, pngs: dict[str, bytes]) -> str:
     """The report as one self-contained HTML page."""
-    parts = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>Recoil absorber replication report"
-             f"</title><style>{_CSS}</style></head><body>",
+    parts = ["<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
+             "<meta name='viewport' content='width=device-width, initial-scale=1'>"
+             f"<title>Recoil absorber replication report</title><style>{_CSS}</style></head><body>",
              "<h1>Replication report: recoil mechanism with impact absorbers</h1>",
              "<p>Engine: Exudyn (symbolic user functions, accuracy preset "
              f"<code>{_e(data['options']['accuracy'])}</code>). Independent check: an event-driven scipy solution of "
              "the same equations (<code>validation.reference</code>). Nothing is tuned to the published numbers; where "
              "we differ, the difference is reported and studied.</p>"]
+    contents_at = len(parts)        # the table of contents goes here, once every section is known
+    sections: list[tuple[str, str]] = []
+
+    def section(section_id: str, title: str) -> str:
+        """The numbered heading of the next section, recorded for the table of contents."""
+        sections.append((section_id, title))
+        return f"<h2 id='{section_id}'>{len(sections)}. {_e(title)}</h2>"
+
     # models
-    parts.append("<h2 id='models'>1. Models and equations</h2>")
+    parts.append(section("models", "Models and equations"))
     for title, func in (("Simplified model (Fig. 1)", _simp_doc), ("Model (i) (Fig. 2)", _model_i_doc),
                         ("Model (ii) (Fig. 3)", _model_ii_doc)):
         parts.append(f"<h3>{_e(title)}</h3><pre>{_e(_sketch(func))}</pre>")
     parts.append(f"<pre>{_e(_EQUATIONS)}</pre>")
     # parameters
-    parts.append("<h2 id='parameters'>2. Parameters</h2>")
+    parts.append(section("parameters", "Parameters"))
     rows = [[_e(p.quantity), _e(p.model), _fmt(p.value, 6), _e(p.unit), _e(p.source), _e(p.note)]
             for p in published_values() if p.model == "all"]
-    parts.append(_table(["quantity", "model", "value", "unit", "source", "note"], rows, left=2, table_id="parameters"))
+    parts.append(_table(["quantity", "model", "value", "unit", "source", "note"], rows, left=2,
+                        table_id="tab-parameters"))
     # table 2
     t2 = table2_rows(data)
-    parts.append("<h2 id='table2'>3. Table 2: maximum barrel displacement (gap 0, 10 s)</h2>")
-    parts.append(_table(["model", "m [kg]", "ours [m]", "reference [m]", "paper [m]", "ours - paper [mm]",
-                         "relative", "engine vs reference"],
-                        [[_e(r["model"]), f"{r['absorber_mass']:g}", f"{r['engine']:.5f}", f"{r['reference']:.5f}",
-                          f"{r['paper']:.4f}", f"{r['difference'] * 1e3:+.2f}", _pct(r["relative_difference"]),
-                          f"{r['engine_vs_reference']:.1e}"] for r in t2], table_id="table2"))
+    parts.append(section("table2", "Table 2: maximum barrel displacement and force on the mount (gap 0, 10 s)"))
+    parts.append(_table(["model", "m [kg]", "ours [m]", "peak support force [kN]", "reference [m]", "paper [m]",
+                         "ours - paper [mm]", "relative", "engine vs reference"],
+                        [[_e(r["model"]), f"{r['absorber_mass']:g}", f"{r['engine']:.5f}", _kn(r["peak_support_force"]),
+                          f"{r['reference']:.5f}", f"{r['paper']:.4f}", f"{r['difference'] * 1e3:+.2f}",
+                          _pct(r["relative_difference"]), f"{r['engine_vs_reference']:.1e}"] for r in t2],
+                        table_id="tab-table2"))
+    parts.append("<p id='mount-force'>Peak support force: the largest magnitude of the force on the mount (what "
+                 "the recoil spring and damper, and in model (ii) the absorber's spring and damper, transmit to the "
+                 "ground) over the 10 s, engine. Moderating it is what a recoil mechanism is for; the paper does not "
+                 "report it.</p><ul id='mount-force-verdict'>"
+                 + "".join(f"<li>{_e(sentence)}</li>" for sentence in mount_force_sentences(t2)) + "</ul>")
+    mass = mount_force_mass(data)
+    name = f"support_force_m{mass:g}"
+    parts.append(_img(name, pngs[name], f"Force on the mount: support force of the three models, m = {mass:g} kg, "
+                                        f"gap 0, first {MOUNT_FORCE_WINDOW:g} s"))
     # sweeps
-    parts.append("<h2 id='sweeps'>4. Gap sweeps (Figs 4 and 5)</h2>")
+    parts.append(section("sweeps", "Gap sweeps (Figs 4 and 5)"))
     gap_step = data["options"]["gap_step"]
     parts.append(f"<p>Gaps 0 to {data['options']['gap_max'] * 1e3:g} mm in {gap_step * 1e3:g} mm steps, engine; "
                  "crosses mark the independent reference.</p>")
@@ -509,16 +659,16 @@ def render_html(data: dict, pngs: dict[str, bytes]) -> str:
     parts.append(_img("fig4_gap_sweep_model_i", pngs["fig4_gap_sweep_model_i"], "Fig. 4 (ours): model (i)"))
     parts.append(_img("fig5_gap_sweep_model_ii", pngs["fig5_gap_sweep_model_ii"], "Fig. 5 (ours): model (ii)"))
     # time histories
-    parts.append("<h2 id='histories'>5. Time histories (Figs 6-8)</h2>")
+    parts.append(section("histories", "Time histories (Figs 6-8)"))
     for mass in data["options"]["masses"]:
         name = f"barrel_displacement_m{mass:g}"
         parts.append(_img(name, pngs[name], f"Barrel displacement, m = {mass:g} kg (paper: Figs 6-8)"))
-    parts.append("<h2 id='contact'>6. Contact force and absorber velocity (Figs 9-11)</h2>")
+    parts.append(section("contact", "Contact force and absorber velocity (Figs 9-11)"))
     s22 = section22_rows(data)
     parts.append(_table(["model", "quantity", "ours", "paper", "unit", "relative", "source"],
                         [[_e(r["model"]), _e(r["quantity"].replace("_", " ")), _fmt(r["ours"], 5), _fmt(r["paper"], 5),
                           _e(r["unit"]), _pct(r["relative_difference"]), _e(r["source"])] for r in s22],
-                        left=2, table_id="section22"))
+                        left=2, table_id="tab-section22"))
     for mass in data["options"]["masses"]:
         for stem, caption in (("contact_force", "Contact force (Fig. 9), with the paper's detail windows"),
                               ("absorber_velocity", "Absorber velocity (Fig. 10)"),
@@ -526,7 +676,7 @@ def render_html(data: dict, pngs: dict[str, bytes]) -> str:
             name = f"{stem}_m{mass:g}"
             parts.append(_img(name, pngs[name], f"{caption}, m = {mass:g} kg"))
     # engine vs reference
-    parts.append("<h2 id='engine-vs-reference'>7. Engine vs independent reference, every case shown</h2>")
+    parts.append(section("engine-vs-reference", "Engine vs independent reference, every case shown"))
     rows = []
     for c in data["comparisons"]:
         err = {x["name"]: x["relative_error"] for x in c["checks"]}
@@ -538,9 +688,9 @@ def render_html(data: dict, pngs: dict[str, bytes]) -> str:
     parts.append("<p>Relative errors; tolerances 1e-4 (displacement), 1e-3 (force, velocity, histories); the "
                  "impact counts must be equal.</p>")
     parts.append(_table(["case", "x_max", "peak force", "v_max absorber", "x_M(t)", "x_m(t)",
-                         "impacts engine / ref.", "verdict"], rows, table_id="engine-vs-reference"))
+                         "impacts engine / ref.", "verdict"], rows, table_id="tab-engine-vs-reference"))
     # conventions
-    parts.append("<h2 id='conventions'>8. Convention study: readings of the paper</h2>")
+    parts.append(section("conventions", "Convention study: readings of the paper"))
     parts.append("<p>Each reading alone (reference values; the engine runs the same scenes). Relative differences "
                  "to the paper; RMS over the 6 Table 2 cells with an absorber and the 6 Section 2.2 numbers.</p>")
     conv_rows = []
@@ -552,7 +702,8 @@ def render_html(data: dict, pngs: dict[str, bytes]) -> str:
         worst = max((v for v in engine.values() if not isinstance(v, str)), default=None)
         engine_text = (f"max {worst:.1e}" if worst is not None else "") + (
             f"; <span class='bad'>{failures} cases fail</span> (sticking contact)" if failures else "")
-        conv_rows.append([_e(row.label)] + [_pct(t2e[(m, mass)]) for m in (MODEL_I, MODEL_II) for mass in TABLE2_MASSES]
+        conv_rows.append([_e(reading_name(row))]
+                         + [_pct(t2e[(m, mass)]) for m in (MODEL_I, MODEL_II) for mass in TABLE2_MASSES]
                          + [_pct(s2e[(MODEL_I, "peak_contact_force")]), _pct(s2e[(MODEL_I, "max_absorber_velocity")]),
                             f"{row.rms_error() * 100:.1f} %",
                             ", ".join(f"{x * 1e3:.1f}" for x in row.trend()), engine_text])
@@ -561,31 +712,31 @@ def render_html(data: dict, pngs: dict[str, bytes]) -> str:
     if data["conventions"]:
         parts.append(_table(["reading", "(i) 100", "(i) 500", "(i) 1000", "(ii) 100", "(ii) 500", "(ii) 1000",
                              "F (i)", "v (i)", "RMS", "(ii) x_max at 0/40/80 mm [mm]", "engine vs reference"],
-                            conv_rows, table_id="conventions"))
+                            conv_rows, table_id="tab-conventions"))
         parts.append(_img("conventions_gap_trend", pngs["conventions_gap_trend"],
                           "Model (ii) vs gap under each reading"))
     else:
         parts.append(not_run)
     # calibration
     calibration = data["calibration"]
-    parts.append("<h2 id='calibration'>9. Contact-law calibration on Section 2.2</h2>")
+    parts.append(section("calibration", "Contact-law calibration on Section 2.2"))
     if calibration is not None:
-        parts.append(f"<pre>{_e(calibration.summary())}</pre>")
+        parts.append(f"<pre class='wrap'>{_e(calibration.summary())}</pre>")  # long lines wrap in the box
         parts.append(_table(["model", "m [kg]", "predicted x_max [m]", "paper [m]", "relative"],
                             [[_e(r["model"]), f"{r['absorber_mass']:g}", f"{r['max_barrel_displacement']:.4f}",
                               _fmt(r["published"]), _pct(r["relative_error"])] for r in data["calibration_table2"]],
-                            table_id="calibration-table2"))
+                            table_id="tab-calibration-table2"))
     else:
         parts.append(not_run)
     # claims
-    parts.append("<h2 id='claims'>10. The paper's qualitative claims</h2>")
+    parts.append(section("claims", "The paper's qualitative claims"))
     parts.append(_table(["claim", "source", "holds?", "evidence"],
                         [[_e(v.claim.text), _e(v.claim.source),
                           "<span class='good'>yes</span>" if v.holds else
                           ("&ndash;" if v.holds is None else "<span class='bad'>no</span>"), _e(v.evidence)]
-                         for v in data.get("claims", [])], left=4, table_id="claims"))
+                         for v in data.get("claims", [])], left=4, table_id="tab-claims"))
     # unreproduced
-    parts.append("<h2 id='unreproduced'>11. Published numbers we cannot reproduce, and the most likely reason</h2>")
+    parts.append(section("unreproduced", "Published numbers we cannot reproduce, and the most likely reason"))
     parts.append(f"<p>Counted as reproduced: within {REPRODUCED_WITHIN * 100:g} % of the published value.</p><ul "
                  "id='unreproduced-list'>")
     for item in data["unreproduced"]:
@@ -596,13 +747,14 @@ def render_html(data: dict, pngs: dict[str, bytes]) -> str:
     parts.append("</ul>")
     timing_rows = [[_e(k), f"{v:.1f} s"] for k, v in data["timings"].items()]
     machine = data.get("machine", {})
-    parts.append("<h2 id='cost'>12. What this report cost</h2>" + _table(["stage", "wall time"], timing_rows)
+    parts.append(section("cost", "What this report cost") + _table(["stage", "wall time"], timing_rows)
                  + (f"<p>{machine.get('cpus')} CPUs, {machine.get('workers')} worker processes, load average "
                     f"{machine.get('load_average_at_start')} at the start (other programs share the CPUs). The gap "
                     "sweeps and the convention study stop each run once its peak metrics are proven final by "
                     "energy bounds (same values as the full 10 s runs); the engine-vs-reference cases and the "
                     "time histories run the full 10 s.</p>" if machine else ""))
     parts.append("</body></html>")
+    parts.insert(contents_at, _contents(sections))
     return "\n".join(parts)
 
 
@@ -650,9 +802,12 @@ def write_report(out: str | Path, options: ReportOptions = ReportOptions(), prog
     for name, png in pngs.items():
         atomic_write_bytes(out / f"{name}.png", png)
     rows = table2_rows(data)
-    atomic_write_text(out / "table2.md", "# Table 2: maximum barrel displacement, gap 0, 10 s\n\n"
-                      "Ours = Exudyn engine (standard); reference = independent scipy solution.\n\n" + table2_markdown(rows))
-    atomic_write_json(out / "table2.json", {"rows": rows})
+    atomic_write_text(out / "table2.md", "# Table 2: maximum barrel displacement and force on the mount, "
+                      "gap 0, 10 s\n\n"
+                      "Ours = Exudyn engine (standard); reference = independent scipy solution; peak support force "
+                      "= largest |force on the mount| (engine).\n\n" + table2_markdown(rows) + "\n"
+                      + "".join(f"- {sentence}\n" for sentence in mount_force_sentences(rows)))
+    atomic_write_json(out / "table2.json", {"rows": rows, "units": TABLE2_UNITS})
     data["timings"]["total"] = time.perf_counter() - start
     atomic_write_json(out / "results.json", results_json(data))
     atomic_write_text(out / "report.html", render_html(data, pngs))

@@ -1,30 +1,169 @@
-"""The replication report builds on a reduced sweep, and every figure and table is present."""
+"""The replication report builds on a reduced sweep, and every figure and table is present.
+
+The page is also read as a browser would: :func:`page_problems` parses it with ``html.parser`` and lists
+what a reader would see as broken (empty boxes, dead links, images that are not PNGs, ...).
+"""
 
 from __future__ import annotations
 
+import base64
+import html
 import json
 import re
+import struct
+import zlib
 from html.parser import HTMLParser
 
 import pytest
 
 from mbs_models.cli import main
-from validation.studies.report import ReportOptions, write_report
+from validation.studies.report import ReportOptions, _sketch, write_report
 
 
-class _Collector(HTMLParser):
+# ------------------------------------------------------------------------------------- reading the page
+#: Characters an ASCII drawing is made of.
+DRAWING = set("|/\\-=+[]<>")
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+SUPPORT_FORCE_HEADER = "peak support force [kN]"
+
+
+class _Page(HTMLParser):
+    """What a reader meets in the page: ids, sections, preformatted boxes, links, images, tables, text."""
+
     def __init__(self):
         super().__init__()
-        self.ids, self.images, self.tables = set(), [], 0
+        self.ids: list[str] = []
+        self.sections: list[str | None] = []        # the id of every <h2>, in order
+        self.pres: list[dict] = []                   # {"section", "after_h3", "text"}
+        self.contents_links: list[str] = []          # href of every link in the table of contents
+        self.contents_found = False
+        self.images: list[str] = []
+        self.tables: list[dict] = []                 # {"section", "headers", "rows"}
+        self.text: list[str] = []                    # visible text and attribute values but image data
+        self._section: str | None = None
+        self._after_h3 = False
+        self._pre: dict | None = None
+        self._nav_depth = 0
+        self._cell: list[str] | None = None
+        self._row: list[str] | None = None
 
     def handle_starttag(self, tag, attrs):
         attrs = dict(attrs)
+        self.text += [str(v) for k, v in attrs.items() if k != "src" and v]
         if "id" in attrs:
-            self.ids.add(attrs["id"])
+            self.ids.append(attrs["id"])
+        if tag == "h2":
+            self._section = attrs.get("id")
+            self.sections.append(self._section)
+        if tag == "pre":
+            self._pre = {"section": self._section, "after_h3": self._after_h3, "text": ""}
+        if tag == "nav" and attrs.get("id") == "contents":
+            self.contents_found = True
+            self._nav_depth = 1
+        elif tag == "nav" and self._nav_depth:
+            self._nav_depth += 1
+        if tag == "a" and self._nav_depth:
+            self.contents_links.append(attrs.get("href", ""))
         if tag == "img":
             self.images.append(attrs.get("src", ""))
         if tag == "table":
-            self.tables += 1
+            self.tables.append({"section": self._section, "headers": [], "rows": []})
+        if tag == "tr" and self.tables:
+            self._row = []
+        if tag in ("th", "td"):
+            self._cell = []
+        if tag not in ("pre", "h3"):
+            self._after_h3 = False          # a sketch is the box right after a model's <h3>
+
+    def handle_endtag(self, tag):
+        if tag == "h3":
+            self._after_h3 = True
+        if tag == "pre" and self._pre is not None:
+            self.pres.append(self._pre)
+            self._pre, self._after_h3 = None, False
+        if tag == "nav" and self._nav_depth:
+            self._nav_depth -= 1
+        if tag in ("th", "td") and self._cell is not None:
+            cell = "".join(self._cell).strip()
+            if tag == "th":
+                self.tables[-1]["headers"].append(cell)
+            elif self._row is not None:
+                self._row.append(cell)
+            self._cell = None
+        if tag == "tr" and self._row:
+            self.tables[-1]["rows"].append(self._row)
+            self._row = None
+
+    def handle_data(self, data):
+        self.text.append(data)
+        if self._pre is not None:
+            self._pre["text"] += data
+        if self._cell is not None:
+            self._cell.append(data)
+
+
+def _png_size(png: bytes) -> tuple[int, int] | None:
+    """(width, height) from a PNG's header chunk, None when the bytes do not start as a PNG."""
+    if len(png) < 24 or png[:8] != PNG_SIGNATURE or png[12:16] != b"IHDR":
+        return None
+    return struct.unpack(">II", png[16:24])
+
+
+def _is_drawing(text: str) -> bool:
+    lines = [line for line in text.splitlines() if line.strip()]
+    return len(lines) >= 3 and sum(ch in DRAWING for ch in text) >= 10
+
+
+def page_problems(html_text: str) -> list[str]:
+    """What is broken in the report page, as a reader would see it (an empty list: nothing)."""
+    page = _Page()
+    page.feed(html_text)
+    page.close()
+    problems = []
+    # boxes: no empty one; the model sketches are drawings
+    problems += [f"empty <pre> in section {p['section']!r}" for p in page.pres if not p["text"].strip()]
+    sketches = [p for p in page.pres if p["section"] == "models" and p["after_h3"]]
+    problems += [f"model sketch without a drawing: {p['text'][:40]!r}" for p in sketches if not _is_drawing(p["text"])]
+    problems += [f"<pre> under 'Models and equations' with no drawing characters: {p['text'][:40]!r}"
+                 for p in page.pres if p["section"] == "models" and not DRAWING & set(p["text"])]
+    if len(sketches) < 3:
+        problems.append(f"{len(sketches)} model sketches under 'Models and equations', 3 expected")
+    # ids and the table of contents
+    problems += [f"id {i!r} appears {page.ids.count(i)} times" for i in sorted(set(page.ids)) if page.ids.count(i) > 1]
+    if not page.contents_found:
+        problems.append("no table of contents (<nav id='contents'>)")
+    targets = [href[1:] for href in page.contents_links if href.startswith("#")]
+    problems += [f"contents link {href!r} is not a link within the page" for href in page.contents_links
+                 if not href.startswith("#")]
+    problems += [f"contents link to #{t}, which no element has" for t in targets if t not in page.ids]
+    problems += [f"section {s!r} missing from the table of contents" for s in page.sections if s not in targets]
+    # images: embedded PNGs with a size
+    for number, src in enumerate(page.images):
+        prefix = "data:image/png;base64,"
+        try:
+            png = base64.b64decode(src[len(prefix):], validate=True) if src.startswith(prefix) else b""
+        except ValueError:
+            png = b""
+        size = _png_size(png)
+        if size is None or min(size) <= 0:
+            problems.append(f"image {number} is not a PNG with a size: {src[:40]!r}")
+    # no reference to a document the reader does not have
+    if any("DESIGN.md" in text for text in page.text):
+        problems.append("the page cites DESIGN.md")
+    # Table 2 has the force on the mount, in kN, for every row
+    table2 = next((t for t in page.tables if t["section"] == "table2"), None)
+    if table2 is None:
+        problems.append("no Table 2 (a table in the section with id 'table2')")
+    elif SUPPORT_FORCE_HEADER not in table2["headers"]:
+        problems.append(f"Table 2 has no {SUPPORT_FORCE_HEADER!r} column: {table2['headers']}")
+    else:
+        column = table2["headers"].index(SUPPORT_FORCE_HEADER)
+        for row in table2["rows"]:
+            try:
+                assert float(row[column]) > 0
+            except (AssertionError, IndexError, ValueError):
+                problems.append(f"Table 2 row {row[:2]} has no positive support force: {row}")
+    return problems
 
 
 @pytest.fixture(scope="module")
@@ -36,21 +175,23 @@ def report_dir(tmp_path_factory):
 
 def test_report_html_has_every_section_figure_and_table(report_dir):
     text = (report_dir / "report.html").read_text()
-    parser = _Collector()
-    parser.feed(text)
+    page = _Page()
+    page.feed(text)
+    ids = set(page.ids)
     for section in ("models", "parameters", "table2", "sweeps", "histories", "contact", "engine-vs-reference",
                     "conventions", "calibration", "claims", "unreproduced", "cost"):
-        assert section in parser.ids, section
+        assert section in ids, section
     for table in ("parameters", "table2", "section22", "engine-vs-reference", "conventions", "calibration-table2",
                   "claims"):
-        assert table in parser.ids, table
-    expected_figures = {"fig4_gap_sweep_model_i", "fig5_gap_sweep_model_ii", "conventions_gap_trend"} | {
+        assert f"tab-{table}" in ids, table
+    expected_figures = {"fig4_gap_sweep_model_i", "fig5_gap_sweep_model_ii", "conventions_gap_trend",
+                        "support_force_m1000"} | {
         f"{stem}_m{m}" for stem in ("barrel_displacement", "contact_force", "absorber_velocity", "first_impact")
         for m in (100, 500, 1000)}
-    assert {f"fig-{name}" for name in expected_figures} <= parser.ids
+    assert {f"fig-{name}" for name in expected_figures} <= ids
     # self-contained: every image is embedded PNG data, no external references
-    assert len(parser.images) == len(expected_figures)
-    assert all(src.startswith("data:image/png;base64,") and len(src) > 5000 for src in parser.images)
+    assert len(page.images) == len(expected_figures)
+    assert all(src.startswith("data:image/png;base64,") and len(src) > 5000 for src in page.images)
     assert not re.search(r'src="(http|file|/)', text)
     for name in expected_figures:
         assert (report_dir / f"{name}.png").read_bytes()[:4] == b"\x89PNG"
@@ -86,3 +227,180 @@ def test_full_report_builds(tmp_path):
     assert all(len(points) == 121 for points in data["sweeps"].values()) and len(data["sweeps"]) == 6
     assert not data["sweep_failures"]
     assert (tmp_path / "report.html").stat().st_size > 100_000
+
+
+# ----------------------------------------------------------------------------------- force on the mount
+#: Section 2.1 of the paper, for bounds on the force on the mount that do not come from the code under test.
+RECOIL_STIFFNESS = 27500.0                    # k, N/m
+RECOIL_DAMPING = 6239.0                       # c while x_M' > 0, N s/m
+INITIAL_VELOCITY = 6.86 * 564.0 / 5600.0      # v0 = m_p v_p / M, m/s
+
+
+def _markdown_rows(text: str) -> list[dict]:
+    lines = [line for line in text.splitlines() if line.startswith("|") and not line.startswith("|---")]
+    headers = [cell.strip() for cell in lines[0].strip("|").split("|")]
+    return [dict(zip(headers, (cell.strip() for cell in line.strip("|").split("|")))) for line in lines[1:]]
+
+
+def test_table2_gives_the_force_on_the_mount(report_dir):
+    table = json.loads((report_dir / "table2.json").read_text())
+    assert table["units"]["peak_support_force"] == "N" and table["units"]["engine"] == "m"
+    rows = {(r["model"], r["absorber_mass"]): r for r in table["rows"]}
+    assert len(rows) == 9
+    for (model, mass), r in rows.items():
+        force = r["peak_support_force"]
+        # at t = 0 the barrel moves at v0 and nothing else touches the ground: the mount feels c v0
+        assert force >= RECOIL_DAMPING * INITIAL_VELOCITY * (1 - 1e-6), (model, mass)
+        if model != "model (ii)":  # the barrel stops at its largest displacement: the recoil spring alone, k x_max
+            assert force >= RECOIL_STIFFNESS * r["engine"] * (1 - 1e-6), (model, mass)
+        assert 0.0 <= r["time_of_peak_support_force"] <= 10.0
+    assert len({rows[("simplified", m)]["peak_support_force"] for m in (100.0, 500.0, 1000.0)}) == 1
+    # table2.md: the same numbers, in kN
+    for row in _markdown_rows((report_dir / "table2.md").read_text()):
+        expected = rows[(row["model"], float(row["m [kg]"]))]["peak_support_force"] / 1e3
+        assert float(row["peak support force [kN]"]) == pytest.approx(expected, abs=0.005)
+    # results.json: the same rows, from the same gap-0 runs as the time histories
+    results = json.loads((report_dir / "results.json").read_text())
+    assert [r["peak_support_force"] for r in results["table2"]] == [r["peak_support_force"] for r in table["rows"]]
+    for (model, mass), r in rows.items():
+        key = model if model == "simplified" else f"{model}:{mass:g}"
+        assert results["time_histories"][key]["peak_support_force"] == r["peak_support_force"]
+
+
+def test_the_mount_force_verdict_follows_table2(report_dir):
+    text = (report_dir / "report.html").read_text()
+    page = _Page()
+    page.feed(text)
+    table2 = next(t for t in page.tables if t["section"] == "table2")
+    force, x_max = table2["headers"].index(SUPPORT_FORCE_HEADER), table2["headers"].index("ours [m]")
+    verdict = re.search(r"<ul id='mount-force-verdict'>(.*?)</ul>", text, re.DOTALL)
+    assert verdict, "no verdict on the force on the mount under Table 2"
+    sentences = [html.unescape(item) for item in re.findall(r"<li>(.*?)</li>", verdict.group(1))]
+    for mass in ("100", "500", "1000"):
+        cases = [(row[0], float(row[x_max]), float(row[force])) for row in table2["rows"] if row[1] == mass]
+        assert len(cases) == 3
+        lowest = min(cases, key=lambda case: case[2])
+        shortest = min(cases, key=lambda case: case[1])
+        sentence = next(s for s in sentences if s.startswith(f"m = {mass} kg:"))
+        assert sentence.startswith(f"m = {mass} kg: {lowest[0]} moderates the force on the mount most"), sentence
+        if shortest is not lowest:
+            assert f"{shortest[0]} recoils least" in sentence and "harder on the mount" in sentence, sentence
+    assert "fig-support_force_m1000" in page.ids
+
+# ------------------------------------------------------------------------------------------ model sketches
+@pytest.mark.parametrize("name", ["simplified_model", "model_i", "model_ii"])
+def test_model_sketch_is_the_docstrings_drawing_with_its_indentation(name):
+    from mbs_models.scene import models
+
+    func = getattr(models, name)
+    sketch = _sketch(func).splitlines()
+    assert len(sketch) >= 4, sketch
+    assert any(line.startswith("|") for line in sketch), "the ground line of the drawing, moved to the left edge"
+    assert any(line.startswith(" ") for line in sketch), "the drawing's own indentation is kept"
+    # every line of the sketch is a line of the docstring, all shifted left by the same amount
+    doc = func.__doc__.splitlines()
+    ground = next(line for line in sketch if line.startswith("|"))
+    shift = next(len(d) - len(ground) for d in doc if d.endswith(ground) and not d[:len(d) - len(ground)].strip())
+    assert all(" " * shift + line in doc for line in sketch if line.strip())
+    assert "Parameters" not in "\n".join(sketch)
+
+
+def _first_line_block():
+    """A drawing::
+
+            top
+        |--+
+        |  |
+
+    After the drawing.
+    """
+
+
+def _later_paragraph_block():
+    """Summary.
+
+    The drawing follows::
+
+        a
+          b
+
+        c
+    Text again.
+    """
+
+
+def _drawing_only():
+    """Only a drawing::
+
+            x
+        |---|
+    """
+
+
+def _no_block():
+    """No drawing here: just text."""
+
+
+@pytest.mark.parametrize("func, expected", [
+    (_first_line_block, "    top\n|--+\n|  |"),
+    (_later_paragraph_block, "a\n  b\n\nc"),
+    (_drawing_only, "    x\n|---|"),
+    (_no_block, ""),
+])
+def test_sketch_extraction_follows_the_literal_block(func, expected):
+    assert _sketch(func) == expected
+
+
+# ------------------------------------------------------------------- the page as a reader sees it
+def test_reduced_report_reads_right_in_a_browser(report_dir):
+    assert page_problems((report_dir / "report.html").read_text()) == []
+
+
+def _tiny_png(width: int = 2, height: int = 1) -> bytes:
+    def chunk(kind: bytes, body: bytes) -> bytes:
+        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
+    rows = b"".join(b"\x00" + b"\x00\x00\x00" * width for _ in range(height))
+    return (PNG_SIGNATURE + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0))
+            + chunk(b"IDAT", zlib.compress(rows)) + chunk(b"IEND", b""))
+
+
+_SKETCH = "    k\n|--/\\/\\--+-----+\n|        |  M  |\n|--[ c ]-+-----+\nground"
+_GOOD_PAGE = (
+    "<html><body><h1>Report</h1><p>intro</p>"
+    "<nav id='contents'><ol><li><a href='#models'>Models</a></li><li><a href='#table2'>Table 2</a></li></ol></nav>"
+    "<h2 id='models'>1. Models and equations</h2>"
+    + "".join(f"<h3>Model {n}</h3><pre>{_SKETCH}</pre>" for n in (1, 2, 3))
+    + "<pre>M x'' + k x = 0</pre>"
+    "<h2 id='table2'>2. Table 2</h2><div><table id='tab-table2'><thead><tr><th>model</th><th>m [kg]</th>"
+    "<th>ours [m]</th><th>peak support force [kN]</th></tr></thead><tbody><tr><td>model (i)</td><td>100</td>"
+    "<td>0.22</td><td>6.89</td></tr></tbody></table></div>"
+    f"<figure id='fig-x'><img alt='x' src='data:image/png;base64,{base64.b64encode(_tiny_png()).decode()}'>"
+    "</figure></body></html>")
+
+
+def test_page_checker_passes_a_sound_page():
+    assert _png_size(_tiny_png(3, 5)) == (3, 5)
+    assert page_problems(_GOOD_PAGE) == []
+
+
+@pytest.mark.parametrize("broken, expected", [
+    (_GOOD_PAGE.replace(f"<h3>Model 2</h3><pre>{_SKETCH}</pre>", "<h3>Model 2</h3><pre></pre>"), "empty <pre>"),
+    (_GOOD_PAGE.replace(f"<h3>Model 2</h3><pre>{_SKETCH}</pre>", "<h3>Model 2</h3><pre>k, c\nM\nground</pre>"),
+     "without a drawing"),
+    (_GOOD_PAGE.replace("<pre>M x'' + k x = 0</pre>", "<pre>equations follow</pre>"), "no drawing characters"),
+    (_GOOD_PAGE.replace("id='tab-table2'", "id='table2'"), "id 'table2' appears 2 times"),
+    (_GOOD_PAGE.replace("href='#table2'", "href='#table-2'"), "which no element has"),
+    (_GOOD_PAGE.replace("<li><a href='#table2'>Table 2</a></li>", ""), "missing from the table of contents"),
+    (re.sub("<nav.*</nav>", "", _GOOD_PAGE), "no table of contents"),
+    (_GOOD_PAGE.replace(base64.b64encode(_tiny_png()).decode(), base64.b64encode(b"GIF89a" + bytes(30)).decode()),
+     "not a PNG"),
+    (_GOOD_PAGE.replace(base64.b64encode(_tiny_png()).decode(), base64.b64encode(_tiny_png(0, 1)).decode()),
+     "not a PNG"),
+    (_GOOD_PAGE.replace("data:image/png;base64,", "tiny.png?"), "not a PNG"),
+    (_GOOD_PAGE.replace("<p>intro</p>", "<p>see DESIGN.md</p>"), "DESIGN.md"),
+    (_GOOD_PAGE.replace("<th>peak support force [kN]</th>", "<th>peak support force [N]</th>"), "column"),
+    (_GOOD_PAGE.replace("<td>6.89</td>", "<td>&ndash;</td>"), "no positive support force"),
+])
+def test_page_checker_finds_each_defect(broken, expected):
+    problems = page_problems(broken)
+    assert any(expected in problem for problem in problems), problems

@@ -32,7 +32,7 @@ def test_reproduction_has_the_papers_results_and_says_what_it_left_out(reproduct
     assert text.count("Not computed in this run") == 2
     assert not (reproduction_dir / "conventions_gap_trend.png").exists()
     for stem in ("fig4_gap_sweep_model_i", "fig5_gap_sweep_model_ii", "barrel_displacement_m1000",
-                 "contact_force_m1000", "absorber_velocity_m1000", "first_impact_m1000"):
+                 "contact_force_m1000", "absorber_velocity_m1000", "first_impact_m1000", "support_force_m1000"):
         assert (reproduction_dir / f"{stem}.png").read_bytes()[:4] == b"\x89PNG"
     reasons = [item["reason"] for item in data["unreproduced"] if item["paper"] is not None]
     assert reasons and all("--reproduce-only" in reason for reason in reasons)
