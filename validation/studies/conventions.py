@@ -23,7 +23,7 @@ from .paper import MODEL_I, MODEL_II, SIMPLIFIED, TABLE2_MASSES, published, tabl
 from ..reference import solve_reference
 
 #: (label, conventions) of the readings studied: the default and each flag alone.
-CONVENTION_CASES: tuple[tuple[str, Conventions], ...] = (("default (DESIGN.md)", Conventions()),) + tuple(
+CONVENTION_CASES: tuple[tuple[str, Conventions], ...] = (("default", Conventions()),) + tuple(
     (f.name, Conventions(**{f.name: True})) for f in fields(Conventions))
 
 #: Section 2.2 quantities compared: (metric name, published quantity name).

@@ -226,7 +226,7 @@ def _convention_figure(data: dict):
     fig, axes = new_figure(1, 1, row_height=3.6)
     ax = axes[0, 0]
     for row in data["conventions"]:
-        ax.plot(np.array(TREND_GAPS) * 1e3, np.array(row.trend()) * 1e3, "o-", label=reading_name(row))
+        ax.plot(np.array(TREND_GAPS) * 1e3, np.array(row.trend()) * 1e3, "o-", label=row.label)
     ax.set_xlabel("gap [mm]")
     ax.set_ylabel("max barrel displacement [mm]")
     ax.set_title("Model (ii), m = 1000 kg: each reading of the paper vs gap (Fig. 5 claims a maximum at gap 0)",
@@ -412,13 +412,6 @@ def section22_rows(data: dict) -> list[dict]:
     return rows
 
 
-def reading_name(row) -> str:
-    """The name the report gives a reading of the paper (a row of the convention study): ``"default"`` for
-    the reading with no flag -- its label in the study's data, :data:`CONVENTION_CASES`, names a design
-    document the report's reader does not have -- and the flag's name otherwise."""
-    return "default" if not row.conventions.active else row.label
-
-
 _NOT_STUDIED = ("the readings of the paper and the contact-law calibration were not computed in this run "
                 "(recoil paper --reproduce-only); the full report studies them")
 
@@ -438,7 +431,7 @@ def unreproduced(data: dict) -> list[dict]:
         closest = min(conventions, key=lambda row: (abs(errors_of(row)), row.label))
         signed = errors_of(closest)
         err = abs(signed)
-        text = f"the closest reading of the paper is '{reading_name(closest)}' at {signed * 100:+.1f} %"
+        text = f"the closest reading of the paper is '{closest.label}' at {signed * 100:+.1f} %"
         if err <= REPRODUCED_WITHIN and closest.conventions.active and default_rms is not None:
             text += (f", which reproduces this number but moves the others away (RMS over all published numbers "
                      f"{closest.rms_error() * 100:.1f} % against {default_rms * 100:.1f} % by default): the paper "
@@ -702,7 +695,7 @@ def render_html(data: dict, pngs: dict[str, bytes]) -> str:
         worst = max((v for v in engine.values() if not isinstance(v, str)), default=None)
         engine_text = (f"max {worst:.1e}" if worst is not None else "") + (
             f"; <span class='bad'>{failures} cases fail</span> (sticking contact)" if failures else "")
-        conv_rows.append([_e(reading_name(row))]
+        conv_rows.append([_e(row.label)]
                          + [_pct(t2e[(m, mass)]) for m in (MODEL_I, MODEL_II) for mass in TABLE2_MASSES]
                          + [_pct(s2e[(MODEL_I, "peak_contact_force")]), _pct(s2e[(MODEL_I, "max_absorber_velocity")]),
                             f"{row.rms_error() * 100:.1f} %",
