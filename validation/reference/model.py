@@ -180,6 +180,11 @@ class Connector:
         """Switching surfaces watched in ``state``: ``(event, g(t, y), positive, rate, noise)`` each."""
         return []
 
+    def rough_events(self, state) -> tuple[str, ...]:
+        """Events of ``state`` across which the segment's right-hand side is only C^1 (the solver then
+        integrates the step that crosses one again in short steps)."""
+        return ()
+
     # ------------------------------------------------------------------ bounds (overridden)
     @property
     def linear_stiffness(self) -> float:

@@ -153,6 +153,9 @@ class Restart:
         #: dy/dt at the restart in the new mode (velocities, accelerations, powers)
         self.dy = self.model.rhs(self.mode)(self.t, self.y)
         funcs, names = [], []
+        #: names of the events across which the right-hand side is only C^1
+        self.rough = {f"{c.name}.{event}" for c, state in zip(self.model.connectors, self.mode.states)
+                      for event in c.rough_events(state)}
         for c, state in zip(self.model.connectors, self.mode.states):
             for event, g, positive, rate, noise in c.events(state, self):
                 window = rearm_window(float(g(self.t, self.y)), rate, noise, positive)
