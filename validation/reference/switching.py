@@ -39,13 +39,19 @@ def sided(g, t_start: float, positive: bool, window: float = 0.0):
     For ``t_start <= t <= t_start + window`` the function reports the classified side (a tiny value of
     that sign if ``g`` says otherwise): a surface the state has just left is re-armed only once ``g`` has
     moved clear of round-off noise, so noise in the dense output right after the restart, or a return
-    within the first step, is not mistaken for a crossing at ``t_start``.
+    within the first step, is not mistaken for a crossing at ``t_start``.  Until ``g`` has been seen on
+    the classified side, an exact 0 counts as that side too: a state resting on its surface (a barrel at
+    rest against a battery stop at 0: ``g`` is 0 for ever) is not crossing it.  (Once the state has left
+    the surface an exact 0 is a root like any other: root finding may land on one.)
     """
     sign = 1.0 if positive else -1.0
+    seen = [False]  # has g been seen strictly on the classified side?
 
     def fun(t, y):
         value = g(t, y)
-        if t - t_start <= window and not sign * value > 0:
+        if sign * value > 0:
+            seen[0] = True
+        elif t - t_start <= window or (value == 0 and not seen[0]):
             return sign * 1e-300
         return value
     fun.terminal = True
