@@ -12,7 +12,8 @@ import math
 import numpy as np
 import pytest
 
-from mbs_models.scene import Conventions, model_i, model_ii, simplified_model
+from mbs_models.scene import (Absorber, Barrel, BatteryStop, Contact, Conventions, Firing, RecoilDamper, RecoilSpring,
+                              RecoilStop, Scene, model_i, model_ii, simplified_model)
 from validation.reference import finality
 from validation.reference import solve_reference
 from validation.reference.assembly import build_model
@@ -32,6 +33,32 @@ FAST = {
     "ii-m100-gap120mm": model_ii(100.0, 0.12),
     "ii-literal_gap_sign": model_ii(1000.0, 0.04, Conventions(literal_gap_sign=True)),
     "ii-compression_only": model_ii(1000.0, 0.0, Conventions(compression_only=True)),
+}
+
+def _two_absorbers(**tables) -> Scene:
+    front = Absorber(500.0, "ground", 6750.0, 1837.5, name="front",
+                     contact=Contact(gap=0.0, stiffness=1.05e8, exponent=1.3, damping_factor=0.6))
+    rear = Absorber(400.0, "barrel", 5000.0, 1000.0, name="rear",
+                    contact=Contact(gap=0.01, law="lankarani-nikravesh", stiffness=1e8, exponent=1.5, restitution=0.5))
+    return Scene(barrel=Barrel(5600.0), firing=Firing(6.86, 564.0), recoil_spring=RecoilSpring(27500.0),
+                 recoil_damper=RecoilDamper(6239.0, 14050.0), absorbers=(front, rear), **tables)
+
+
+STOPS = dict(recoil_stop=RecoilStop(position=0.12, law="hunt-crossley", stiffness=1e9, exponent=1.5,
+                                    damping_factor=0.5),
+             battery_stop=BatteryStop(position=-0.02, law="kelvin-voigt", stiffness=5e7, damping=2e5))
+#: the effects of version 2: several absorbers, stops, every law
+NEW = {
+    "two-absorbers": _two_absorbers(),
+    "ii-stops": model_ii(100.0, 0.0).with_changes(**STOPS),
+    "two-absorbers-stops": _two_absorbers(**STOPS),
+    "ii-gonthier": model_ii(1000.0, 0.04).with_changes(contact=Contact(gap=0.04, law="gonthier", stiffness=2.1e8,
+                                                                       exponent=1.3, restitution=0.4)),
+    "i-kelvin-voigt": model_i(500.0, 0.0).with_changes(contact=Contact(gap=0.0, law="kelvin-voigt", stiffness=2e7,
+                                                                       damping=2e4)),
+    "ii-exact-hertz-stop": model_ii(500.0, 0.0).with_changes(
+        contact=Contact(gap=0.0, law="exact-restitution", stiffness=2.1e8, exponent=1.3, restitution=0.3),
+        recoil_stop=RecoilStop(position=0.1, law="hertz", stiffness=1e9, exponent=1.5)),
 }
 SLOW = {
     **{f"{name}-m{mass:g}-gap{gap * 1e3:g}mm": factory(mass, gap)
@@ -59,6 +86,23 @@ def _assert_same_as_full(early, full):
         assert getattr(early, TIMES[name]) == pytest.approx(getattr(full, TIMES[name]), rel=1e-12, abs=1e-15)
     for name in set(ALL) - set(early.final_metrics):
         assert getattr(early, name) is None, name
+    # per absorber and per stop: what the final metrics cover is the full run's too, the rest None
+    peaks, impacts = "peak_contact_force" in early.final_metrics, "impacts" in early.final_metrics
+    for ours, theirs in zip(early.absorber_metrics, full.absorber_metrics):
+        assert (ours.peak_contact_force, ours.time_of_peak_contact_force) == (
+            (theirs.peak_contact_force, theirs.time_of_peak_contact_force) if peaks else (None, None))
+        assert (ours.impacts is None) != impacts
+        if "max_absorber_velocity" in early.final_metrics:
+            assert ours.max_velocity == pytest.approx(theirs.max_velocity, rel=1e-12)
+        else:
+            assert ours.max_velocity is None
+    for name, ours in early.stop_metrics.items():
+        theirs = full.stop_metrics[name]
+        assert ours.peak_force == (theirs.peak_force if peaks else None)
+        if impacts:
+            assert [(i.start, i.end) for i in ours.impacts] == [(i.start, i.end) for i in theirs.impacts]
+        else:
+            assert ours.impacts is None
 
 
 _FULL: dict = {}
@@ -92,6 +136,19 @@ def test_early_stopped_reference_gives_the_full_runs_metrics(key, requested):
     early = _check(FAST[key], requested)
     if key != "ii-literal_gap_sign" or requested != ALL:  # an interference keeps a contact force for ever
         assert early.stop_reason == "metrics_final"
+
+
+@pytest.mark.parametrize("requested", [("max_barrel_displacement",), ("peak_support_force",), ALL],
+                         ids=["x", "S", "all"])
+@pytest.mark.parametrize("key", list(NEW))
+def test_early_stop_with_several_absorbers_stops_and_every_law(key, requested):
+    early = _check(NEW[key], requested)
+    assert early.stop_reason == "metrics_final", (key, requested)
+
+
+@pytest.mark.parametrize("key", ["two-absorbers-stops", "ii-gonthier", "i-kelvin-voigt", "ii-exact-hertz-stop"])
+def test_the_bounds_bound_the_future_with_several_absorbers_stops_and_every_law(key):
+    assert_bounds_hold(_full(NEW[key]), END)
 
 
 @pytest.mark.slow
