@@ -17,23 +17,21 @@ only runs them:
 
 * a **mode** (:class:`Mode`) fixes every connector's discrete state for one smooth segment (a contact's
   phase, the damper's branch), so that the right-hand side is smooth inside a segment;
-* a connector's **kernel** for a state, ``apply(s, f, out) -> F``, reads positions and velocities from
-  the list ``s`` (the state followed by the ground's ``x = v = 0``), adds ``+F`` to ``f[a]`` and ``-F`` to
-  ``f[b]`` (``f`` has one slot per body and a last one for the ground, which so collects S), writes its
-  dissipated power to ``out`` and returns ``F``.  The same kernel runs
-  on Python floats (the integrator's right-hand side: ~10^4-10^5 calls per run, numpy scalar arithmetic
-  would be 5x slower) and on numpy rows (post-processing): only the few operations in :data:`SCALAR` and
-  :data:`ARRAY` differ.  A kernel marked ``constraint`` (a sliding contact) runs after the others: its
-  force depends on theirs.
+* a connector's **equations** for a state (:class:`Equations`) give its force ``F`` (and dissipated power)
+  as a few lines of Python source from the positions and velocities of its ends;
+  :mod:`validation.reference.codegen` joins them, per mode, into one straight-line function that adds
+  ``+F`` to the force on ``a`` and ``-F`` to the force on ``b`` (the ground's collects S): the
+  right-hand side on Python floats, and the same code on numpy rows for post-processing.
 """
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Callable
 
 import numpy as np
+
+from .codegen import compile_mode
 
 #: The name of the ground as a connector end.
 GROUND = "ground"
@@ -43,32 +41,6 @@ BARREL = "barrel"
 
 class ReferenceModelError(ValueError):
     """The scene cannot be modelled by the reference (a table without a reference term, a bad name)."""
-
-
-class _ScalarOps:
-    """Operations on Python floats (the right-hand side)."""
-
-    name = "scalar"
-
-    @staticmethod
-    def spow(p, n):
-        """``sign(p) |p|^n`` (m^n)."""
-        return math.copysign(abs(p) ** n, p)
-
-
-class _ArrayOps:
-    """The same operations on numpy arrays (post-processing, event functions on the dense output)."""
-
-    name = "array"
-
-    @staticmethod
-    def spow(p, n):
-        """``sign(p) |p|^n`` (m^n)."""
-        return np.copysign(np.abs(p) ** n, p)
-
-
-SCALAR = _ScalarOps()
-ARRAY = _ArrayOps()
 
 
 @dataclass(frozen=True)
@@ -89,10 +61,26 @@ def _difference(ia: int | None, ib: int | None) -> Callable:
     return lambda y: y[ib] - y[ia]
 
 
+@dataclass(frozen=True)
+class Equations:
+    """One connector's force in one state, as Python source for :mod:`validation.reference.codegen`.
+
+    ``code``: lines that set ``{F}`` (N) and, for a dissipating connector, ``{P}`` (W: ``F d' - dU/dt``)
+    from ``{xa}``, ``{xb}``, ``{va}``, ``{vb}`` (positions, velocities of a and b; ``0.0`` for the ground)
+    and, for a ``constraint`` (computed after all the others), the forces ``{fa}``, ``{fb}`` on a and b so
+    far.  Every other ``{name}`` is a number of ``constants``; temporaries are plain names; the functions
+    ``abs`` and ``copysign`` are available.
+    """
+
+    code: str
+    constants: dict = field(default_factory=dict)
+    constraint: bool = False
+
+
 class Connector:
     """A force between points ``a`` and ``b`` (body names or :data:`GROUND`); see the module docstring.
 
-    Subclasses (in the term modules) give the law: :meth:`kernel` per state, and what the solver, the
+    Subclasses (in the term modules) give the law: :meth:`equations` per state, and what the solver, the
     result and the early stop need.  Class attributes:
 
     * ``is_contact`` -- a contact (episodes, impacts, onsets are reported for it);
@@ -151,8 +139,8 @@ class Connector:
         return sum(1.0 / m for m in (self.mass_a, self.mass_b) if m is not None)
 
     # ------------------------------------------------------------------ the law (overridden)
-    def kernel(self, state, ops) -> Callable | None:
-        """``apply(s, f, out) -> F`` in ``state`` (see the module docstring); None: no force, no power."""
+    def equations(self, state) -> Equations | None:
+        """The force in ``state`` (:class:`Equations`); None: no force, no power."""
         return None
 
     def reported(self, force):
@@ -224,16 +212,12 @@ class AbsorberRole:
 
 @dataclass
 class Evaluation:
-    """Everything the kernels give at a state (floats) or a batch (arrays).
-
-    ``forces[j]``: raw force of connector j (N, unclipped: the segment's smooth law); ``accelerations[i]``
-    (m/s^2); ``powers``: the time derivative of the state (only the dissipated powers, W, are filled at
-    their indices); ``support``: S (N) from the raw forces.
-    """
+    """What the equations give at a state (floats) or a batch (arrays): ``forces[j]``, the raw force of
+    connector j (N, unclipped: the segment's smooth law); ``accelerations[i]`` (m/s^2); ``support``: S
+    (N) from the raw forces."""
 
     forces: list
     accelerations: list
-    powers: list
     support: Any
 
 
@@ -267,7 +251,7 @@ class Model:
         self.connector_index = {c.name: j for j, c in enumerate(self.connectors)}
         self.names = tuple(c.name for c in self.connectors)
         self.contacts = tuple(c for c in self.connectors if c.is_contact)
-        self._kernels: dict = {}
+        self._compiled: dict = {}
 
     # ------------------------------------------------------------------ state
     def initial_state(self) -> np.ndarray:
@@ -289,59 +273,24 @@ class Model:
             raise KeyError(f"no body {name!r}; the scene has: {', '.join(self.body_index)}")
         return self.body_index[name]
 
-    # ------------------------------------------------------------------ kernels
-    def kernels(self, mode: Mode, ops) -> list[tuple[int, Callable]]:
-        """``(connector index, apply)`` of every force-giving connector in ``mode``, constraints last."""
-        key = (mode, ops.name)
-        cached = self._kernels.get(key)
-        if cached is None:
-            pairs = [(j, c.kernel(state, ops)) for j, (c, state) in enumerate(zip(self.connectors, mode.states))]
-            pairs = [(j, k) for j, k in pairs if k is not None]
-            cached = ([p for p in pairs if not getattr(p[1], "constraint", False)]
-                      + [p for p in pairs if getattr(p[1], "constraint", False)])
-            self._kernels[key] = cached
-        return cached
+    # ------------------------------------------------------------------ compiled equations
+    def compiled(self, mode: Mode, kind: str, omit: int | None = None) -> Callable:
+        """The compiled equations of ``mode`` (:func:`validation.reference.codegen.compile_mode`), cached."""
+        key = (mode, kind, omit)
+        function = self._compiled.get(key)
+        if function is None:
+            function = self._compiled[key] = compile_mode(self, mode, kind, omit)
+        return function
 
     def rhs(self, mode: Mode) -> Callable:
         """``f(t, y) -> dy/dt`` in ``mode`` on Python floats (an overflow gives inf, as numpy would)."""
-        applies = [k for _, k in self.kernels(mode, SCALAR)]
-        n, nb, masses = self.n_states, self.n_bodies, self.masses
-        nf, body_end = nb + 1, 2 * nb
-        ground = [0.0, 0.0]
-
-        def rhs(t, y):
-            try:
-                s = y.tolist()
-                s += ground
-                f = [0.0] * nf
-                out = [0.0] * n
-                for apply in applies:
-                    apply(s, f, out)
-                out[0:body_end:2] = s[1:body_end:2]
-                out[1:body_end:2] = [fi / m for fi, m in zip(f, masses)]
-                return np.array(out)
-            except OverflowError:
-                # a rejected trial step of an explicit method on a stiff contact: numpy gave inf here, and
-                # so does this; the integrator rejects the step (its error estimate is inf)
-                return np.full(n, np.inf)
-        return rhs
+        return self.compiled(mode, "rhs")
 
     def evaluate(self, mode: Mode, y, omit: int | None = None) -> Evaluation:
-        """Forces, accelerations, dissipated powers and support force at a state ``y`` (n,) -- on Python
-        floats -- or a batch (n, N) -- on numpy rows.  ``omit``: leave out connector ``omit``'s force."""
-        scalar = np.ndim(y) == 1
-        ops = SCALAR if scalar else ARRAY
-        s = np.asarray(y, dtype=float).tolist() if scalar else list(np.asarray(y, dtype=float))
-        s += [0.0, 0.0]
-        nb = self.n_bodies
-        f = [0.0] * (nb + 1)
-        out = [0.0] * self.n_states
-        forces = [0.0] * len(self.connectors)
-        for j, apply in self.kernels(mode, ops):
-            if j != omit:
-                forces[j] = apply(s, f, out)
-        accelerations = [fi / m for fi, m in zip(f, self.masses)]
-        return Evaluation(forces, accelerations, out, f[nb])
+        """Forces, accelerations and support force at a state ``y`` (n,) -- on Python floats -- or a batch
+        (n, N) -- on numpy rows.  ``omit``: leave out connector ``omit``'s force."""
+        y = np.asarray(y, dtype=float)
+        return Evaluation(*self.compiled(mode, "scalar" if y.ndim == 1 else "array", omit)(y))
 
     def relative_acceleration(self, connector: Connector, evaluation: Evaluation):
         """d'' = a_b - a_a (m/s^2) of ``connector`` (the ground does not accelerate)."""

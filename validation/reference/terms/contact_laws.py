@@ -44,7 +44,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..closed_form import restitution_factor
-from ..model import Connector, ReferenceModelError
+from ..model import Connector, Equations, ReferenceModelError
 from ..switching import TOL_POS, TOL_S, TOL_VEL, heading
 
 #: Contact phases.
@@ -156,52 +156,34 @@ class ContactConnector(Connector):
             return rate + self.law.damping / self.law.stiffness * acceleration
         return factor * acceleration
 
-    def kernel(self, state: ContactMode, ops):
-        """The force of ``state``; the dissipated power ``(F - k p^n) p'`` goes to the energy state."""
+    def equations(self, state: ContactMode) -> Equations | None:
+        """The force of ``state``; the dissipated power ``(F - k p^n) p'`` (``k p^n`` continued oddly to
+        p < 0, ``sign(p) |p|^n``, so that the law stays smooth across the segment's end)."""
         if state.phase == OFF and not state.penetrated:
             return None
-        ia, ib, fa, fb, di = self.ia, self.ib, self.fa, self.fb, self.di
-        k, n, offset, spow = self.law.stiffness, self.law.exponent, self.offset, ops.spow
+        law = self.law
+        constants = dict(k=law.stiffness, n=law.exponent, offset=self.offset)
+        elastic = """
+            p = {xb} - {xa} - {offset}
+            rate = {vb} - {va}
+            elastic = {k} * copysign(abs(p) ** {n}, p)"""
         if state.phase == OFF:  # clipped (or released, compression_only): the vanishing elastic energy
-            def apply(s, f, out):
-                elastic = k * spow(s[ib] - s[ia] - offset, n)
-                out[di] = (0.0 - elastic) * (s[ib + 1] - s[ia + 1])
-                return 0.0
-        elif state.phase == STICK:
+            return Equations(elastic + """
+                {F} = 0.0
+                {P} = (0.0 - elastic) * rate""", constants)
+        if state.phase == STICK:  # p' = 0 held: F = m_red (f_b/m_b - f_a/m_a) of the other forces
             ma, mb = self.mass_a, self.mass_b
-            m_red = mb * ma / (mb + ma)
-
-            def apply(s, f, out):
-                F = m_red * (f[fb] / mb - f[fa] / ma)
-                f[fa] += F
-                f[fb] -= F
-                elastic = k * spow(s[ib] - s[ia] - offset, n)
-                out[di] = (F - elastic) * (s[ib + 1] - s[ia + 1])
-                return F
-            apply.constraint = True
-        elif self.law.kelvin_voigt:
-            c = self.law.damping
-
-            def apply(s, f, out):
-                rate = s[ib + 1] - s[ia + 1]
-                elastic = k * spow(s[ib] - s[ia] - offset, n)
-                F = elastic + c * rate
-                f[fa] += F
-                f[fb] -= F
-                out[di] = (F - elastic) * rate
-                return F
-        else:
-            a = state.factor
-
-            def apply(s, f, out):
-                rate = s[ib + 1] - s[ia + 1]
-                elastic = k * spow(s[ib] - s[ia] - offset, n)
-                F = elastic * (1.0 + a * rate)
-                f[fa] += F
-                f[fb] -= F
-                out[di] = (F - elastic) * rate
-                return F
-        return apply
+            return Equations("""
+                {F} = {m_red} * ({fb} / {mb} - {fa} / {ma})""" + elastic + """
+                {P} = ({F} - elastic) * rate""", dict(constants, m_red=mb * ma / (mb + ma), ma=ma, mb=mb),
+                             constraint=True)
+        if law.kelvin_voigt:
+            return Equations(elastic + """
+                {F} = elastic + {c} * rate
+                {P} = ({F} - elastic) * rate""", dict(constants, c=law.damping))
+        return Equations(elastic + """
+            {F} = elastic * (1.0 + {a} * rate)
+            {P} = ({F} - elastic) * rate""", dict(constants, a=state.factor))
 
     def reported(self, force):
         """The physical force: the law clipped to >= 0 (N)."""

@@ -11,7 +11,7 @@ damper's force is 0 there on either branch), or the crossing direction if ``a_M 
 
 from __future__ import annotations
 
-from ..model import BARREL, GROUND, Connector
+from ..model import BARREL, GROUND, Connector, Equations
 from ..switching import TOL_VEL
 
 TABLES = ("recoil_damper",)
@@ -32,19 +32,12 @@ class RecoilDamper(Connector):
         """c (N s/m) on the branch ``state`` (True or None: recoil)."""
         return self.counter_recoil if state is False else self.recoil
 
-    def kernel(self, state, ops):
+    def equations(self, state) -> Equations:
         """``F = c d'``, dissipated power ``c d'^2``."""
-        ia, ib, fa, fb, di = self.ia, self.ib, self.fa, self.fb, self.di
-        c = self.coefficient(state)
-
-        def apply(s, f, out):
-            rate = s[ib + 1] - s[ia + 1]
-            F = c * rate
-            f[fa] += F
-            f[fb] -= F
-            out[di] = c * rate ** 2
-            return F
-        return apply
+        return Equations("""
+            rate = {vb} - {va}
+            {F} = {c} * rate
+            {P} = {c} * rate ** 2""", dict(c=self.coefficient(state)))
 
     def force_rate(self, state, d, rate, acceleration):
         """dF/dt = c d'' (N/s)."""

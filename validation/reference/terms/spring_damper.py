@@ -10,7 +10,7 @@ With ``d = x_b - x_a`` (m) and ``d' = v_b - v_a`` (m/s) (DESIGN.md, "Bodies and 
 
 from __future__ import annotations
 
-from ..model import Connector
+from ..model import Connector, Equations
 
 
 class LinearSpringDamper(Connector):
@@ -22,33 +22,20 @@ class LinearSpringDamper(Connector):
         self.dissipates = self.damping > 0
         self.stores_energy = self.stiffness > 0
 
-    def kernel(self, state, ops):
-        """``F = k d + c d'``; the dissipated power ``c d'^2`` goes to the connector's energy state."""
-        ia, ib, fa, fb, di = self.ia, self.ib, self.fa, self.fb, self.di
+    def equations(self, state) -> Equations:
+        """``F = k d + c d'``; the dissipated power ``c d'^2``."""
         k, c = self.stiffness, self.damping
         if c == 0.0:
-            def apply(s, f, out):
-                F = k * (s[ib] - s[ia])
-                f[fa] += F
-                f[fb] -= F
-                return F
-        elif k == 0.0:
-            def apply(s, f, out):
-                rate = s[ib + 1] - s[ia + 1]
-                F = c * rate
-                f[fa] += F
-                f[fb] -= F
-                out[di] = c * rate ** 2
-                return F
-        else:
-            def apply(s, f, out):
-                rate = s[ib + 1] - s[ia + 1]
-                F = k * (s[ib] - s[ia]) + c * rate
-                f[fa] += F
-                f[fb] -= F
-                out[di] = c * rate ** 2
-                return F
-        return apply
+            return Equations("{F} = {k} * ({xb} - {xa})", dict(k=k))
+        if k == 0.0:
+            return Equations("""
+                rate = {vb} - {va}
+                {F} = {c} * rate
+                {P} = {c} * rate ** 2""", dict(c=c))
+        return Equations("""
+            rate = {vb} - {va}
+            {F} = {k} * ({xb} - {xa}) + {c} * rate
+            {P} = {c} * rate ** 2""", dict(k=k, c=c))
 
     def force_rate(self, state, d, rate, acceleration):
         """dF/dt = k d' + c d'' (N/s)."""
