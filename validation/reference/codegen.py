@@ -58,7 +58,7 @@ def source(model, mode, kind: str, omit: int | None = None) -> str:
         lines += [f"{fa} += F{j}", f"{fb} -= F{j}"]
         (late if equations.constraint else blocks).append(lines)
         forces[j] = f"F{j}"
-        if c.dissipates and f"{{P}}" in equations.code:
+        if c.dissipates and "{P}" in equations.code:
             powers[j] = f"P{j}"
     for lines in blocks + late:
         body += lines

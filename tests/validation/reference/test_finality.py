@@ -8,12 +8,12 @@ really bound the future of the dense solution.  The two independent bound implem
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-from mbs_models.scene import (Absorber, Barrel, BatteryStop, Contact, Conventions, Firing, RecoilDamper, RecoilSpring,
-                              RecoilStop, Scene, model_i, model_ii, simplified_model)
+from mbs_models.scene import Contact, Conventions, RecoilStop, load_scene, model_i, model_ii, simplified_model
 from validation.reference import finality
 from validation.reference import solve_reference
 from validation.reference.assembly import build_model
@@ -35,23 +35,14 @@ FAST = {
     "ii-compression_only": model_ii(1000.0, 0.0, Conventions(compression_only=True)),
 }
 
-def _two_absorbers(**tables) -> Scene:
-    front = Absorber(500.0, "ground", 6750.0, 1837.5, name="front",
-                     contact=Contact(gap=0.0, stiffness=1.05e8, exponent=1.3, damping_factor=0.6))
-    rear = Absorber(400.0, "barrel", 5000.0, 1000.0, name="rear",
-                    contact=Contact(gap=0.01, law="lankarani-nikravesh", stiffness=1e8, exponent=1.5, restitution=0.5))
-    return Scene(barrel=Barrel(5600.0), firing=Firing(6.86, 564.0), recoil_spring=RecoilSpring(27500.0),
-                 recoil_damper=RecoilDamper(6239.0, 14050.0), absorbers=(front, rear), **tables)
-
-
-STOPS = dict(recoil_stop=RecoilStop(position=0.12, law="hunt-crossley", stiffness=1e9, exponent=1.5,
-                                    damping_factor=0.5),
-             battery_stop=BatteryStop(position=-0.02, law="kelvin-voigt", stiffness=5e7, damping=2e5))
+#: two absorbers (front: ground, hunt-crossley, gap 0; rear: barrel, lankarani-nikravesh, gap 10 mm), both stops
+WITH_STOPS = load_scene(Path(__file__).parent / "data" / "two_absorbers_stops.toml")
+STOPS = dict(recoil_stop=WITH_STOPS.recoil_stop, battery_stop=WITH_STOPS.battery_stop)
 #: the effects of version 2: several absorbers, stops, every law
 NEW = {
-    "two-absorbers": _two_absorbers(),
+    "two-absorbers": WITH_STOPS.with_changes(recoil_stop=None, battery_stop=None),
     "ii-stops": model_ii(100.0, 0.0).with_changes(**STOPS),
-    "two-absorbers-stops": _two_absorbers(**STOPS),
+    "two-absorbers-stops": WITH_STOPS,
     "ii-gonthier": model_ii(1000.0, 0.04).with_changes(contact=Contact(gap=0.04, law="gonthier", stiffness=2.1e8,
                                                                        exponent=1.3, restitution=0.4)),
     "i-kelvin-voigt": model_i(500.0, 0.0).with_changes(contact=Contact(gap=0.0, law="kelvin-voigt", stiffness=2e7,

@@ -4,11 +4,10 @@ restitution extremes 0.05 and 0.99 are in test_restitution.py.)"""
 
 from __future__ import annotations
 
-import math
 
 import numpy as np
 import pytest
-from scipy.optimize import brentq
+from scipy.optimize import brentq, minimize_scalar
 
 from mbs_models.scene import (Absorber, Barrel, BatteryStop, Contact, Conventions, Firing, RecoilDamper, RecoilSpring,
                               RecoilStop, Scene, model_ii)
@@ -76,7 +75,6 @@ def test_grazing_return_onto_the_battery_stop():
     free = solve_reference(base, 4.0)
     t = np.linspace(0.0, 4.0, 40001)
     i = int(np.argmin(free.barrel_position(t)))
-    from scipy.optimize import minimize_scalar
     turn = minimize_scalar(free.barrel_position, bounds=(t[i - 1], t[i + 1]), method="bounded",
                            options={"xatol": 1e-12})
     x_min, a_turn = float(turn.fun), float(free.acceleration("barrel", turn.x))

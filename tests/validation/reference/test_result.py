@@ -4,35 +4,28 @@ per-contact, per-absorber and per-stop metrics, against definitions and conserva
 from __future__ import annotations
 
 import functools
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-from mbs_models.scene import (Absorber, Barrel, BatteryStop, Contact, Firing, RecoilDamper, RecoilSpring, RecoilStop,
-                              Scene, model_i, model_ii, simplified_model)
+from mbs_models.scene import load_scene, model_i, model_ii, simplified_model
 from validation.reference import solve_reference
 
 END = 2.0
 
 
-def two_absorbers(**tables) -> Scene:
-    front = Absorber(500.0, "ground", 6750.0, 1837.5, name="front",
-                     contact=Contact(gap=0.0, stiffness=1.05e8, exponent=1.3, damping_factor=0.6))
-    rear = Absorber(400.0, "barrel", 5000.0, 1000.0, name="rear",
-                    contact=Contact(gap=0.01, law="lankarani-nikravesh", stiffness=1e8, exponent=1.5, restitution=0.5))
-    return Scene(barrel=Barrel(5600.0), firing=Firing(6.86, 564.0), recoil_spring=RecoilSpring(27500.0),
-                 recoil_damper=RecoilDamper(6239.0, 14050.0), absorbers=(front, rear), **tables)
+#: two absorbers (front: ground, hunt-crossley, gap 0; rear: barrel, lankarani-nikravesh, gap 10 mm), both stops
+WITH_STOPS = load_scene(Path(__file__).parent / "data" / "two_absorbers_stops.toml")
+TWO = WITH_STOPS.with_changes(recoil_stop=None, battery_stop=None)
+STOPS = dict(recoil_stop=WITH_STOPS.recoil_stop, battery_stop=WITH_STOPS.battery_stop)
 
-
-STOPS = dict(recoil_stop=RecoilStop(position=0.12, law="hunt-crossley", stiffness=1e9, exponent=1.5,
-                                    damping_factor=0.5),
-             battery_stop=BatteryStop(position=-0.02, law="kelvin-voigt", stiffness=5e7, damping=2e5))
 SCENES = {
     "simplified": simplified_model(),
     "i": model_i(500.0, 0.0),
     "ii": model_ii(1000.0, 0.04),
-    "two-absorbers": two_absorbers(),
-    "two-absorbers-stops": two_absorbers(**STOPS),
+    "two-absorbers": TWO,
+    "two-absorbers-stops": WITH_STOPS,
     "ii-stops": model_ii(100.0, 0.0).with_changes(**STOPS),
 }
 
