@@ -129,8 +129,9 @@ def test_early_stopped_reference_gives_the_full_runs_metrics(key, requested):
         assert early.stop_reason == "metrics_final"
 
 
-@pytest.mark.parametrize("requested", [("max_barrel_displacement",), ("peak_support_force",), ALL],
-                         ids=["x", "S", "all"])
+@pytest.mark.parametrize("requested", [ALL, pytest.param(("max_barrel_displacement",), marks=pytest.mark.slow),
+                                       pytest.param(("peak_support_force",), marks=pytest.mark.slow)],
+                         ids=["all", "x", "S"])
 @pytest.mark.parametrize("key", list(NEW))
 def test_early_stop_with_several_absorbers_stops_and_every_law(key, requested):
     early = _check(NEW[key], requested)
