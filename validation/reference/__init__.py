@@ -1,18 +1,28 @@
 """The independent reference: the scene's equations integrated with scipy, event-driven, without Exudyn.
 
-Written from the design document's equations; it imports nothing of the engine (``mbs_models``) --
-``tests/validation/reference/test_independence.py`` checks what it imports against an allow-list.
-SI units throughout (m, s, kg, N, J).
+Written from the design document's equations (DESIGN.md); it imports nothing of the engine
+(``mbs_models``) and reads the scene as data -- ``tests/validation/reference/test_independence.py``
+checks what it imports against an allow-list.  SI units throughout (m, s, kg, N, J).
 
 * :func:`solve_reference` -- event-driven ``solve_ivp`` solution -> :class:`ReferenceResult`;
-* :func:`simplified_max_displacement`, :func:`hunt_crossley_restitution` -- closed-form oracles.
+* :mod:`.terms` -- one module per physical effect (bodies, forces, energies, switching surfaces, bounds);
+  :mod:`.model`, :mod:`.assembly`, :mod:`.switching`, :mod:`.solver`, :mod:`.result` and
+  :mod:`.finality` (the early stop) run them without naming any effect;
+* :mod:`.closed_form` -- oracles: :func:`simplified_max_displacement`, :func:`hunt_crossley_restitution`,
+  :func:`restitution_factor`, :func:`exact_restitution_factor`, :func:`achieved_restitution`,
+  :func:`kelvin_voigt_restitution`.
 """
 
-from .closed_form import hunt_crossley_restitution, simplified_max_displacement
-from .result import ReferenceImpact, ReferenceResult, ReferenceSegment
+from .closed_form import (achieved_restitution, exact_restitution_factor, hunt_crossley_restitution,
+                          kelvin_voigt_restitution, restitution_factor, simplified_max_displacement)
+from .model import ReferenceModelError
+from .result import (AbsorberMetrics, ContactMetrics, ReferenceImpact, ReferenceResult, ReferenceSegment,
+                     StopMetrics)
 from .solver import METHODS, ReferenceSolveError, solve_reference
 
 __all__ = [
     "solve_reference", "ReferenceResult", "ReferenceImpact", "ReferenceSegment", "ReferenceSolveError",
-    "METHODS", "simplified_max_displacement", "hunt_crossley_restitution",
+    "ReferenceModelError", "ContactMetrics", "StopMetrics", "AbsorberMetrics", "METHODS",
+    "simplified_max_displacement", "hunt_crossley_restitution", "restitution_factor", "exact_restitution_factor",
+    "achieved_restitution", "kelvin_voigt_restitution",
 ]

@@ -2,36 +2,41 @@
 
 Every metric is located on the dense interpolant, not on samples: a maximum of ``f`` is found at a root of
 ``f'`` (``brentq`` on the interpolated derivative, bracketed on the solver's steps subdivided 4 times)
-or at a segment end (segment ends are the exact events of :mod:`validation.reference`).
+or at a segment end (segment ends are the exact events of :mod:`validation.reference.solver`).  Nothing
+here names an effect: bodies, connectors, contacts and the roles (absorbers, stops) come from the model
+(:mod:`validation.reference.model`); only the version-1 names of the API (``barrel_position``,
+``peak_contact_force``, ...) say which body or connector they read.
+
+Names (DESIGN.md): bodies ``barrel`` and the absorbers' names; connectors ``recoil_spring``,
+``recoil_damper``, ``absorber_damper`` and ``contact`` (one absorber) or ``<name>_damper`` and
+``<name>_contact`` (several), ``recoil_stop``, ``battery_stop``.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from functools import cached_property
 from typing import Any, Callable
 
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
-from mbs_models.scene import Scene
-
-from . import equations as eq
-from .equations import OFF, ON, Mode, Parameters
+from .finality import METRICS
+from .model import Mode, Model
 
 #: Why a solve ended (:attr:`ReferenceResult.stop_reason`).
 STOP_END_TIME = "end_time"
 STOP_METRICS_FINAL = "metrics_final"
 STOP_NO_BOUND = "end_time_no_energy_bound"
-_ALL_FINAL = ("max_barrel_displacement", "peak_contact_force", "max_absorber_velocity", "impacts")
 _SUBDIVISIONS = 4
-_STATE_NAMES = ("x_M", "v_M", "x_m", "v_m", "E_recoil_damper", "E_absorber_damper", "E_contact")
-_DISSIPATION_KEYS = ("recoil_damper", "absorber_damper", "contact")
+#: Local maxima whose bracket stays this fraction of the value range below the best grid value are not
+#: refined: between two grid points (a quarter of a solver step) no solution rises that much.
+_PRUNE = 1e-2
 
 
 @dataclass(frozen=True)
 class ReferenceSegment:
-    """One smooth piece ``[t0, t1]`` (s) integrated in one ``mode``; ``sol(t)`` is the 7-state dense output."""
+    """One smooth piece ``[t0, t1]`` (s) integrated in one ``mode``; ``sol(t)`` is the state's dense output."""
 
     t0: float
     t1: float
@@ -41,20 +46,52 @@ class ReferenceSegment:
 
 @dataclass(frozen=True)
 class ReferenceImpact:
-    """A contact episode (maximal interval with F > 0) whose peak force exceeds the impact threshold.
-
-    start, end, time_of_peak in s; peak_force in N.
-    """
+    """A contact episode (maximal interval with F > 0) of contact ``contact``; with a peak above the impact
+    threshold it is an impact.  start, end, time_of_peak in s; peak_force in N."""
 
     start: float
     end: float
     peak_force: float
     time_of_peak: float
+    contact: str = ""
 
     @property
     def duration(self) -> float:
         """Contact duration in s."""
         return self.end - self.start
+
+
+@dataclass(frozen=True)
+class ContactMetrics:
+    """One contact: its peak force (N) and time (s), episodes, impacts (above the threshold) and onsets
+    ``(t, v-)`` (s, m/s: the start of every interval with p > 0 and p' there).  Peak and impacts are None
+    when an early stop did not prove them final."""
+
+    name: str
+    peak_force: float | None
+    time_of_peak: float | None
+    episodes: list
+    impacts: list | None
+    onsets: list
+
+
+@dataclass(frozen=True)
+class StopMetrics(ContactMetrics):
+    """An end stop: its contact's metrics and its dissipated energy at the end time (J)."""
+
+    dissipated_energy: float = 0.0
+
+
+@dataclass(frozen=True)
+class AbsorberMetrics:
+    """One absorber: peak contact force (N) and time (s), largest velocity (m/s) and time, impacts."""
+
+    name: str
+    peak_contact_force: float | None
+    time_of_peak_contact_force: float | None
+    max_velocity: float | None
+    time_of_max_velocity: float | None
+    impacts: list | None
 
 
 def _grid(seg: ReferenceSegment) -> np.ndarray:
@@ -67,45 +104,72 @@ def _grid(seg: ReferenceSegment) -> np.ndarray:
     return np.concatenate((inner.ravel(), ts[-1:]))
 
 
-def _segment_maxima(seg: ReferenceSegment, value: Callable, deriv: Callable | None) -> list[tuple[float, float]]:
-    """Candidate maxima ``(t, f)`` of ``f = value(mode, y)`` in a segment: its ends and interior peaks."""
-    tg = _grid(seg)
-    yg = seg.sol(tg)
-    fg = np.broadcast_to(value(seg.mode, yg), tg.shape)
-    out = [(float(tg[0]), float(fg[0])), (float(tg[-1]), float(fg[-1]))]
-    if deriv is None:  # no analytic derivative: bounded scalar maximisation around the grid maximum
-        i = int(np.argmax(fg))
-        if 0 < i < len(tg) - 1:
-            res = minimize_scalar(lambda s: -float(value(seg.mode, seg.sol(s))), bounds=(tg[i - 1], tg[i + 1]),
-                                  method="bounded", options={"xatol": 1e-15})
-            out.append((float(res.x), -float(res.fun)))
-        return out
-    dg = np.broadcast_to(deriv(seg.mode, yg), tg.shape)
-    for i in np.nonzero((dg[:-1] > 0) & (dg[1:] <= 0))[0]:
-        tr = brentq(lambda s: float(deriv(seg.mode, seg.sol(s))), tg[i], tg[i + 1], xtol=1e-16, maxiter=200)
-        out.append((float(tr), float(value(seg.mode, seg.sol(tr)))))
-    return out
-
-
 def _best(candidates) -> tuple[float, float]:
     """(t, f) with the largest f; the earliest on ties."""
     return max(candidates, key=lambda c: (c[1], -c[0]))
+
+
+def _peak(segments, value: Callable, deriv: Callable) -> tuple[float, float]:
+    """Largest ``f = value(mode, y)`` over ``segments`` as ``(t, f)``: segment ends and interior maxima.
+
+    ``deriv(mode, y)`` is df/dt, or None where it has no closed form (then a bounded scalar maximisation
+    around the segment's grid maximum).  Interior maxima are roots of df/dt where it falls through 0.
+    """
+    grids = []
+    for seg in segments:
+        tg = _grid(seg)
+        yg = seg.sol(tg)
+        grids.append((seg, tg, yg, np.broadcast_to(value(seg.mode, yg), tg.shape)))
+    top = max(float(fg.max()) for *_, fg in grids)
+    floor = top - _PRUNE * (top - min(float(fg.min()) for *_, fg in grids))
+    out = []
+    for seg, tg, yg, fg in grids:
+        out += [(float(tg[0]), float(fg[0])), (float(tg[-1]), float(fg[-1]))]
+        if fg.max() < floor:
+            continue
+        dg = deriv(seg.mode, yg)
+        if dg is None:  # no analytic derivative: bounded scalar maximisation around the grid maximum
+            i = int(np.argmax(fg))
+            if 0 < i < len(tg) - 1:
+                res = minimize_scalar(lambda s: -float(value(seg.mode, seg.sol(s))), bounds=(tg[i - 1], tg[i + 1]),
+                                      method="bounded", options={"xatol": 1e-15})
+                out.append((float(res.x), -float(res.fun)))
+            continue
+        dg = np.broadcast_to(dg, tg.shape)
+        for i in np.nonzero((dg[:-1] > 0) & (dg[1:] <= 0) & (np.maximum(fg[:-1], fg[1:]) >= floor))[0]:
+            tr = brentq(lambda s: float(deriv(seg.mode, seg.sol(s))), tg[i], tg[i + 1], xtol=1e-16, maxiter=200)
+            out.append((float(tr), float(value(seg.mode, seg.sol(tr)))))
+    return _best(out)
+
+
+def _runs(segments, active: Callable) -> list[list[ReferenceSegment]]:
+    """Maximal runs of consecutive segments for which ``active(segment)`` holds."""
+    runs, run = [], []
+    for seg in segments:
+        if active(seg):
+            run.append(seg)
+        elif run:
+            runs.append(run)
+            run = []
+    return runs + ([run] if run else [])
 
 
 @dataclass
 class ReferenceResult:
     """Dense reference solution of one scene over ``[0, end_time]`` s, with metrics (SI units).
 
-    Metrics for the absorber and the contact are ``None`` for the simplified model (no absorber).
     ``requested_end_time`` is what was asked; ``end_time`` is earlier only when ``stop_when_final``
     stopped the solve (``stop_reason == "metrics_final"``): then metrics not listed in
     ``final_metrics`` (and their times; ``impacts`` too) are None, never values of the shorter window.
+    Absorber metrics are None without absorbers; the absorber-specific histories (``absorber_position``,
+    ``penetration``, ``contact_force``, ``accelerations``, ``contact_episodes``) read the one absorber
+    (0 / None without) and raise ValueError with several (use ``position(name, t)``, ``contacts``).
     """
 
-    scene: Scene
+    scene: Any
+    model: Model
     end_time: float
     segments: list[ReferenceSegment]
-    parameters: Parameters
     method: str = "DOP853"
     rtol: float = 1e-10
     atol: float = 1e-12
@@ -114,7 +178,7 @@ class ReferenceResult:
     wall_time: float = 0.0
     requested_end_time: float | None = None
     stop_reason: str = STOP_END_TIME
-    final_metrics: tuple[str, ...] = _ALL_FINAL
+    final_metrics: tuple[str, ...] = METRICS
     _starts: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self):
@@ -124,6 +188,26 @@ class ReferenceResult:
 
     def _final(self, metric: str) -> bool:
         return metric in self.final_metrics
+
+    # ---------------------------------------------------------------- names
+    @property
+    def bodies(self) -> tuple[str, ...]:
+        """Body names in state order: ``barrel``, then the absorbers."""
+        return tuple(b.name for b in self.model.bodies)
+
+    @property
+    def connectors(self) -> tuple[str, ...]:
+        """Connector names in scene order (only those that exist)."""
+        return self.model.names
+
+    def _one_absorber(self):
+        """The one absorber's role (None without; ValueError with several)."""
+        absorbers = self.model.absorbers
+        if len(absorbers) > 1:
+            raise ValueError(f"the scene has {len(absorbers)} absorbers ({', '.join(a.name for a in absorbers)}): "
+                             f"use position(name, t), velocity(name, t), connector_force(name, t), contacts, "
+                             f"absorber_metrics")
+        return absorbers[0] if absorbers else None
 
     # ---------------------------------------------------------------- evaluation
     def _per_segment(self, t, fn: Callable, rows: int | None):
@@ -141,68 +225,126 @@ class ReferenceResult:
             out[..., sel] = fn(seg.mode, seg.sol(ta[sel]))
         return out[..., 0] if scalar else out
 
+    def _evaluated(self, t, pick: Callable, rows: int | None = None):
+        """``pick(evaluation, y)`` of :meth:`Model.evaluate` at times ``t``."""
+        model = self.model
+        return self._per_segment(t, lambda mode, y: pick(model.evaluate(mode, y), y), rows)
+
     def state(self, t):
-        """State ``[x_M, v_M, x_m, v_m, E_rd, E_ad, E_c]`` at ``t`` (s): shape (7,) or (7, len(t))."""
-        return self._per_segment(t, lambda mode, y: y, 7)
+        """State ``[x_0, v_0, x_1, v_1, ..., D_0, ...]`` at ``t`` (s): shape (n,) or (n, len(t))."""
+        return self._per_segment(t, lambda mode, y: y, self.model.n_states)
+
+    def position(self, body: str, t):
+        """x of ``body`` (m)."""
+        i = self.model.body(body)
+        return self._per_segment(t, lambda mode, y: y[2 * i], None)
+
+    def velocity(self, body: str, t):
+        """v of ``body`` (m/s)."""
+        i = self.model.body(body)
+        return self._per_segment(t, lambda mode, y: y[2 * i + 1], None)
+
+    def acceleration(self, body: str, t):
+        """a of ``body`` (m/s^2)."""
+        i = self.model.body(body)
+        return self._evaluated(t, lambda ev, y: ev.accelerations[i])
+
+    def connector_force(self, name: str, t):
+        """F of connector ``name`` (N; contacts >= 0): it pushes b towards -x and a towards +x."""
+        c = self.model.connector(name)
+        return self._evaluated(t, lambda ev, y: c.reported(ev.forces[c.index]))
+
+    def support_force(self, t):
+        """S = sum of F over connectors from the ground - sum over connectors to the ground (N, positive in
+        the recoil direction): the force on the mount."""
+        return self._evaluated(t, lambda ev, y: self._support(ev))
+
+    def _support(self, ev):
+        return sum((c.support_sign * c.reported(ev.forces[c.index]) for c in self.model.connectors
+                    if c.support_sign != 0), 0.0)
 
     def barrel_position(self, t):
         """x_M (m)."""
-        return self.state(t)[0]
+        return self.position("barrel", t)
 
     def barrel_velocity(self, t):
         """v_M (m/s)."""
-        return self.state(t)[1]
+        return self.velocity("barrel", t)
 
     def absorber_position(self, t):
-        """x_m (m); 0 for the simplified model."""
-        return self.state(t)[2]
+        """x_m (m) of the one absorber; 0 without absorber."""
+        a = self._one_absorber()
+        return 0.0 * self.barrel_position(t) if a is None else self.position(a.body, t)
 
     def absorber_velocity(self, t):
-        """v_m (m/s); 0 for the simplified model."""
-        return self.state(t)[3]
+        """v_m (m/s) of the one absorber; 0 without absorber."""
+        a = self._one_absorber()
+        return 0.0 * self.barrel_position(t) if a is None else self.velocity(a.body, t)
 
     def penetration(self, t):
-        """Contact penetration p (m); 0 for the simplified model."""
-        P = self.parameters
-        return self._per_segment(t, lambda mode, y: eq.penetration(P, y) if P.has_absorber else 0.0 * y[0], None)
+        """Penetration p (m) of the one absorber's contact; 0 without absorber."""
+        a = self._one_absorber()
+        if a is None:
+            return 0.0 * self.barrel_position(t)
+        c = self.model.connector(a.contact)
+        return self._per_segment(t, lambda mode, y: c.d_of(y) - c.offset, None)
 
     def contact_force(self, t):
-        """Contact force F (N), >= 0; 0 for the simplified model."""
-        P = self.parameters
-        return self._per_segment(t, lambda mode, y: eq.contact_force(P, y, mode), None)
+        """Contact force F (N, >= 0) of the one absorber; 0 without absorber."""
+        a = self._one_absorber()
+        return 0.0 * self.barrel_position(t) if a is None else self.connector_force(a.contact, t)
 
     def accelerations(self, t):
-        """(a_M, a_m) in m/s^2, shape (2,) or (2, len(t))."""
-        P = self.parameters
-        return self._per_segment(t, lambda mode, y: np.array(eq.accelerations(P, y, mode)), 2)
+        """(a_M, a_m) in m/s^2 (a_m = 0 without absorber), shape (2,) or (2, len(t))."""
+        a = self._one_absorber()
+        j = None if a is None else self.model.body(a.body)
+        return self._evaluated(t, lambda ev, y: np.array([ev.accelerations[0],
+                                                          0.0 * y[0] if j is None else ev.accelerations[j]]), 2)
+
+    # ---------------------------------------------------------------- energy
+    def kinetic_energy(self, t) -> dict[str, np.ndarray]:
+        """m v^2 / 2 per body (J)."""
+        return self.model.kinetic_energies(self.state(t))
+
+    def stored_energy(self, t) -> dict[str, np.ndarray]:
+        """U per connector that stores energy: springs ``k d^2 / 2``, contacts' elastic energy (J)."""
+        return self.model.stored_energies(self.state(t))
+
+    def dissipated_energy_history(self, t) -> dict[str, np.ndarray]:
+        """Dissipated energy D per dissipating connector (J) at ``t``."""
+        return self.model.dissipated_energies(self.state(t))
+
+    @property
+    def dissipated_energy(self) -> dict[str, float]:
+        """Dissipated energies at ``end_time`` in J, by connector (``recoil_damper``, ``absorber_damper``,
+        ``contact``, ...: only connectors that exist and dissipate)."""
+        return {k: float(v) for k, v in self.dissipated_energy_history(self.end_time).items()}
 
     def energy_components(self, t) -> dict[str, np.ndarray]:
-        """Energies (J) at ``t``: kinetic, springs, contact elastic, and the three dissipated energies."""
-        return eq.energy_components(self.parameters, self.state(t))
+        """The parts of the energy balance (J): ``kinetic:<body>``, ``stored:<connector>``,
+        ``dissipated:<connector>``; they sum to :meth:`energy_balance`."""
+        y = self.state(t)
+        model = self.model
+        return {**{f"kinetic:{k}": v for k, v in model.kinetic_energies(y).items()},
+                **{f"stored:{k}": v for k, v in model.stored_energies(y).items()},
+                **{f"dissipated:{k}": v for k, v in model.dissipated_energies(y).items()}}
 
     def energy_balance(self, t):
-        """Total energy (J): kinetic + springs + contact elastic + dissipated; constant = initial_energy."""
+        """Total energy (J): kinetic + stored + dissipated; constant = initial_energy."""
         return sum(self.energy_components(t).values())
 
     @property
     def initial_energy(self) -> float:
-        """Energy at t = 0 in J (initial kinetic energy, plus elastic energy with an initial interference)."""
+        """Energy at t = 0 in J (initial kinetic energy, plus elastic energy of an initial interference)."""
         return float(self.energy_balance(0.0))
 
-    def dissipated_energy_history(self, t) -> dict[str, np.ndarray | None]:
-        """Dissipated energies (J) at ``t``; ``None`` entries for the absorber parts of the simplified model."""
-        y = self.state(t)
-        return {key: (y[4 + i] if (i == 0 or self.parameters.has_absorber) else None)
-                for i, key in enumerate(_DISSIPATION_KEYS)}
-
-    @property
-    def dissipated_energy(self) -> dict[str, float | None]:
-        """Dissipated energies at ``end_time`` in J: recoil_damper, absorber_damper, contact."""
-        return {k: (None if v is None else float(v))
-                for k, v in self.dissipated_energy_history(self.end_time).items()}
-
     def sample(self, n=None) -> dict[str, np.ndarray]:
-        """Arrays on a time grid: the solver's step points (``n=None``), ``n`` uniform points, or given times."""
+        """Arrays on a time grid: the solver's step points (``n=None``), ``n`` uniform points, or given times.
+
+        Keys: ``t``; ``x_M``, ``v_M``; ``x:<body>``, ``v:<body>``, ``F:<connector>``, ``E_<connector>``
+        (dissipated), ``support_force``; with at most one absorber also ``x_m``, ``v_m``,
+        ``contact_force``, ``penetration`` (0 without absorber).
+        """
         if n is None:
             ts = [np.asarray(s.sol.ts, dtype=float) for s in self.segments]
             t = np.unique(np.concatenate([[0.0]] + [x[(x >= s.t0) & (x <= s.t1)] for x, s in zip(ts, self.segments)]
@@ -212,19 +354,104 @@ class ReferenceResult:
         else:
             t = np.asarray(n, dtype=float)
         y = self.state(t)
-        out = {"t": t, **{name: y[i] for i, name in enumerate(_STATE_NAMES)}}
-        out["contact_force"] = self.contact_force(t)
-        out["penetration"] = self.penetration(t)
+        out = {"t": t, "x_M": y[0], "v_M": y[1]}
+        for i, name in enumerate(self.bodies):
+            out[f"x:{name}"], out[f"v:{name}"] = y[2 * i], y[2 * i + 1]
+        for name in self.connectors:
+            out[f"F:{name}"] = self.connector_force(name, t)
+        for name, history in self.model.dissipated_energies(y).items():
+            out[f"E_{name}"] = history
+        out["support_force"] = self.support_force(t)
+        if len(self.model.absorbers) <= 1:
+            out["x_m"], out["v_m"] = self.absorber_position(t), self.absorber_velocity(t)
+            out["contact_force"], out["penetration"] = self.contact_force(t), self.penetration(t)
         return out
 
-    # ---------------------------------------------------------------- metrics
-    def _global_max(self, value, deriv) -> tuple[float, float]:
-        return _best(c for seg in self.segments for c in _segment_maxima(seg, value, deriv))
+    # ---------------------------------------------------------------- refined maxima
+    def _force_value(self, j: int) -> Callable:
+        c, model = self.model.connectors[j], self.model
+        return lambda mode, y: c.reported(model.evaluate(mode, y).forces[j])
+
+    def _force_rate(self, j: int) -> Callable:
+        """dF/dt of connector j (N/s), or None in a state without a closed form."""
+        c, model = self.model.connectors[j], self.model
+
+        def rate(mode, y):
+            return c.force_rate(mode.states[j], c.d_of(y), c.rate_of(y),
+                                model.relative_acceleration(c, model.evaluate(mode, y)))
+        return rate
 
     @cached_property
     def _barrel_max(self):
-        return self._global_max(lambda mode, y: y[0], lambda mode, y: y[1])
+        return _peak(self.segments, lambda mode, y: y[0], lambda mode, y: y[1])
 
+    @cached_property
+    def _velocity_max(self) -> dict[str, tuple[float, float]]:
+        """(t, v_max) per absorber."""
+        model, out = self.model, {}
+        for a in model.absorbers:
+            i = model.body(a.body)
+            out[a.name] = _peak(self.segments, lambda mode, y: y[2 * i + 1],
+                                lambda mode, y: model.evaluate(mode, y).accelerations[i])
+        return out
+
+    @cached_property
+    def _episodes(self) -> dict[str, list[ReferenceImpact]]:
+        """Per contact: every episode (maximal run of segments with a force), with its peak."""
+        out = {}
+        for c in self.model.contacts:
+            j, value, rate = c.index, self._force_value(c.index), self._force_rate(c.index)
+            episodes = []
+            for run in _runs(self.segments, lambda seg: seg.mode.states[j].phase != "off"):
+                t_peak, f_peak = _peak(run, value, rate)
+                episodes.append(ReferenceImpact(run[0].t0, run[-1].t1, f_peak, t_peak, c.name))
+            out[c.name] = episodes
+        return out
+
+    def _onsets(self, j: int) -> list[tuple[float, float]]:
+        """(t, v-) at the start of every interval with p > 0 of contact j."""
+        out, before = [], False
+        for seg in self.segments:
+            state = seg.mode.states[j]
+            if state.penetrated and not before:
+                out.append((seg.t0, state.onset_rate))
+            before = state.penetrated
+        return out
+
+    def _contact_peak(self, name: str) -> tuple[float, float]:
+        """(t, F) of the largest force of contact ``name``; (0, 0) if it never touched."""
+        episodes = self._episodes[name]
+        if not episodes:
+            return (0.0, 0.0)
+        best = max(episodes, key=lambda e: (e.peak_force, -e.time_of_peak))
+        return (best.time_of_peak, best.peak_force)
+
+    def _impacts_of(self, name: str) -> list[ReferenceImpact]:
+        return [e for e in self._episodes[name] if e.peak_force > self.impact_threshold]
+
+    @cached_property
+    def _support_max(self) -> tuple[float, float]:
+        """(t, |S|max) over the run."""
+        ground = [c for c in self.model.connectors if c.support_sign != 0]
+        if not ground:
+            return (0.0, 0.0)
+        values = {c.index: self._force_value(c.index) for c in ground}
+        rates = {c.index: self._force_rate(c.index) for c in ground}
+
+        def support(mode, y):
+            return sum(c.support_sign * values[c.index](mode, y) for c in ground)
+
+        def value(mode, y):
+            return np.abs(support(mode, y))
+
+        def deriv(mode, y):
+            parts = [rates[c.index](mode, y) for c in ground]
+            if any(p is None for p in parts):
+                return None
+            return np.sign(support(mode, y)) * sum(c.support_sign * p for c, p in zip(ground, parts))
+        return _peak(self.segments, value, deriv)
+
+    # ---------------------------------------------------------------- metrics
     @property
     def max_barrel_displacement(self) -> float | None:
         """Largest x_M over [0, end_time] in m (None if the solve stopped before proving it final)."""
@@ -235,90 +462,96 @@ class ReferenceResult:
         """Time (s) of :attr:`max_barrel_displacement`."""
         return self._barrel_max[0] if self._final("max_barrel_displacement") else None
 
-    @cached_property
-    def _absorber_max(self):
-        P = self.parameters
-        if not P.has_absorber:
-            return None
-        return self._global_max(lambda mode, y: y[3], lambda mode, y: eq.accelerations(P, y, mode)[1])
+    def _largest(self, pairs, metric: str):
+        pairs = list(pairs)
+        return _best(pairs) if pairs and self._final(metric) else None
 
     @property
     def max_absorber_velocity(self) -> float | None:
-        """Largest absorber velocity v_m (m/s); None for the simplified model."""
-        if self._absorber_max is None or not self._final("max_absorber_velocity"):
-            return None
-        return self._absorber_max[1]
+        """Largest absorber velocity (m/s) over all absorbers; None without absorbers."""
+        best = self._largest(self._velocity_max.values(), "max_absorber_velocity")
+        return None if best is None else best[1]
 
     @property
     def time_of_max_absorber_velocity(self) -> float | None:
-        """Time (s) of :attr:`max_absorber_velocity`; None for the simplified model."""
-        if self._absorber_max is None or not self._final("max_absorber_velocity"):
-            return None
-        return self._absorber_max[0]
-
-    def _force_derivative(self, mode: Mode, y):
-        """dF/dt (N/s) in the ON mode: k_c [n p^(n-1) p' s + p^n lambda p'']."""
-        P = self.parameters
-        p, pd, s = eq.penetration(P, y), eq.penetration_rate(P, y), eq.damping_term(P, y)
-        a_M, a_m = eq.accelerations(P, y, mode)
-        pp = np.maximum(p, 0.0)
-        dpow = P.n * np.where(pp > 0, pp, 1.0) ** (P.n - 1.0) * (pp > 0)
-        return P.kc * (dpow * pd * s + pp ** P.n * P.lam * (a_M - a_m))
-
-    @cached_property
-    def _episodes(self) -> list[ReferenceImpact]:
-        """All contact episodes (maximal runs of segments with a contact force), with their peaks."""
-        P = self.parameters
-        if not P.has_absorber:
-            return []
-        force = lambda mode, y: eq.contact_force(P, y, mode)  # noqa: E731
-        episodes, run = [], []
-        for seg in self.segments + [None]:
-            if seg is not None and seg.mode.contact != OFF:
-                run.append(seg)
-                continue
-            if run:
-                cands = [c for s in run for c in
-                         _segment_maxima(s, force, self._force_derivative if s.mode.contact == ON else None)]
-                t_peak, f_peak = _best(cands)
-                episodes.append(ReferenceImpact(run[0].t0, run[-1].t1, f_peak, t_peak))
-                run = []
-        return episodes
-
-    @property
-    def contact_episodes(self) -> list[ReferenceImpact] | None:
-        """Every contact episode, whatever its peak force; None for the simplified model."""
-        return list(self._episodes) if self.parameters.has_absorber else None
-
-    @property
-    def impacts(self) -> list[ReferenceImpact] | None:
-        """Contact episodes whose peak force exceeds ``impact_threshold`` N ([] for the simplified model;
-        None if the solve stopped before proving the list final)."""
-        if not self._final("impacts"):
-            return None
-        return [e for e in self._episodes if e.peak_force > self.impact_threshold]
-
-    @cached_property
-    def _force_max(self):
-        if not self.parameters.has_absorber:
-            return None
-        if not self._episodes:
-            return (0.0, 0.0)
-        best = max(self._episodes, key=lambda e: (e.peak_force, -e.time_of_peak))
-        return (best.time_of_peak, best.peak_force)
+        """Time (s) of :attr:`max_absorber_velocity`."""
+        best = self._largest(self._velocity_max.values(), "max_absorber_velocity")
+        return None if best is None else best[0]
 
     @property
     def peak_contact_force(self) -> float | None:
-        """Largest contact force (N) over [0, end_time]; 0 if never in contact; None without absorber."""
-        return None if self._force_max is None or not self._final("peak_contact_force") else self._force_max[1]
+        """Largest absorber contact force (N) over all absorbers; 0 if never in contact; None without."""
+        best = self._largest((self._contact_peak(a.contact) for a in self.model.absorbers), "peak_contact_force")
+        return None if best is None else best[1]
 
     @property
     def time_of_peak_contact_force(self) -> float | None:
-        """Time (s) of :attr:`peak_contact_force`; None without absorber."""
-        return None if self._force_max is None or not self._final("peak_contact_force") else self._force_max[0]
+        """Time (s) of :attr:`peak_contact_force`."""
+        best = self._largest((self._contact_peak(a.contact) for a in self.model.absorbers), "peak_contact_force")
+        return None if best is None else best[0]
+
+    @property
+    def peak_support_force(self) -> float | None:
+        """Largest |S| over the run (N, >= 0)."""
+        return self._support_max[1] if self._final("peak_support_force") else None
+
+    @property
+    def time_of_peak_support_force(self) -> float | None:
+        """Time (s) of :attr:`peak_support_force`."""
+        return self._support_max[0] if self._final("peak_support_force") else None
+
+    @property
+    def impacts(self) -> list[ReferenceImpact] | None:
+        """Episodes of the absorbers' contacts whose peak force exceeds ``impact_threshold`` N, in time order
+        ([] without absorbers; None if the solve stopped before proving the list final)."""
+        if not self._final("impacts"):
+            return None
+        found = [e for a in self.model.absorbers for e in self._impacts_of(a.contact)]
+        return sorted(found, key=lambda e: (e.start, e.end))
+
+    @property
+    def contact_episodes(self) -> list[ReferenceImpact] | None:
+        """Every episode of the one absorber's contact, whatever its peak force; None without absorber."""
+        a = self._one_absorber()
+        return None if a is None else list(self._episodes[a.contact])
+
+    def _contact_metrics(self, c, cls=ContactMetrics, **extra):
+        peak = self._contact_peak(c.name) if self._final("peak_contact_force") else (None, None)
+        impacts = self._impacts_of(c.name) if self._final("impacts") else None
+        return cls(c.name, peak[1], peak[0], list(self._episodes[c.name]), impacts, self._onsets(c.index), **extra)
+
+    @property
+    def contacts(self) -> dict[str, ContactMetrics]:
+        """Every contact (absorbers' and stops'), by connector name."""
+        return {c.name: self._contact_metrics(c) for c in self.model.contacts}
+
+    @property
+    def absorber_metrics(self) -> list[AbsorberMetrics]:
+        """Per absorber, in scene order."""
+        out = []
+        for a in self.model.absorbers:
+            contact = self._contact_metrics(self.model.connector(a.contact))
+            v = self._velocity_max[a.name] if self._final("max_absorber_velocity") else (None, None)
+            out.append(AbsorberMetrics(a.name, contact.peak_force, contact.time_of_peak, v[1], v[0], contact.impacts))
+        return out
+
+    @property
+    def stop_metrics(self) -> dict[str, StopMetrics]:
+        """Per end stop: its contact's metrics and dissipated energy (J)."""
+        dissipated = self.dissipated_energy
+        return {name: self._contact_metrics(self.model.connector(name), StopMetrics,
+                                            dissipated_energy=dissipated[name]) for name in self.model.stops}
 
     def metrics(self) -> dict[str, Any]:
         """The DESIGN.md metric set as plain Python values (impacts as dicts)."""
+        def impacts(items):
+            return None if items is None else [asdict(i) for i in items]
+
+        def contact(m):
+            out = asdict(m)
+            out["episodes"], out["impacts"] = impacts(m.episodes), impacts(m.impacts)
+            out["onsets"] = [list(o) for o in m.onsets]
+            return out
         return {
             "max_barrel_displacement": self.max_barrel_displacement,
             "time_of_max_barrel_displacement": self.time_of_max_barrel_displacement,
@@ -326,9 +559,11 @@ class ReferenceResult:
             "time_of_peak_contact_force": self.time_of_peak_contact_force,
             "max_absorber_velocity": self.max_absorber_velocity,
             "time_of_max_absorber_velocity": self.time_of_max_absorber_velocity,
-            "impacts": None if self.impacts is None else [
-                {"start": i.start, "end": i.end, "peak_force": i.peak_force, "time_of_peak": i.time_of_peak}
-                for i in self.impacts],
+            "impacts": impacts(self.impacts),
+            "peak_support_force": self.peak_support_force,
+            "time_of_peak_support_force": self.time_of_peak_support_force,
+            "absorbers": [{**asdict(m), "impacts": impacts(m.impacts)} for m in self.absorber_metrics],
+            "stops": {name: contact(m) for name, m in self.stop_metrics.items()},
             "end_time": self.end_time,
             "requested_end_time": self.requested_end_time,
             "stop_reason": self.stop_reason,

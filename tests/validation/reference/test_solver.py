@@ -1,11 +1,7 @@
-"""The scipy reference solution (validation.reference) against closed forms, itself and physics."""
+"""The scipy reference solution (validation.reference.solver) against closed forms, itself and physics."""
 
 import functools
 import math
-import os
-import subprocess
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,7 +11,6 @@ from mbs_models.scene import Absorber, Barrel, Contact, Conventions, RecoilDampe
 from validation import (ReferenceSolveError, hunt_crossley_restitution, simplified_max_displacement,
                         solve_reference)
 
-REPO = Path(__file__).resolve().parents[1]
 V0 = 6.86 * 564.0 / 5600.0
 MODELS = {"i": model_i, "ii": model_ii}
 
@@ -121,7 +116,7 @@ def test_simplified_has_no_absorber_metrics():
     assert r.peak_contact_force is None and r.time_of_peak_contact_force is None
     assert r.max_absorber_velocity is None and r.time_of_max_absorber_velocity is None
     assert r.impacts == [] and r.contact_episodes is None
-    assert r.dissipated_energy["absorber_damper"] is None and r.dissipated_energy["contact"] is None
+    assert set(r.dissipated_energy) == {"recoil_damper"}  # only connectors that exist
     assert r.dissipated_energy["recoil_damper"] > 0
     t = np.linspace(0, 10, 1001)
     assert np.all(r.contact_force(t) == 0.0)
@@ -173,14 +168,14 @@ def test_conventions_without_effect_leave_results_unchanged():
 
 def test_compression_only_has_no_restitution_force():
     r = solve_reference(model_ii(1000.0, 0.0, Conventions(compression_only=True)), 2.0)
-    modes = {s.mode.contact for s in r.segments}
+    modes = {s.mode["contact"].phase for s in r.segments}
     assert "stick" in modes  # the bodies ride together at constant penetration after max compression
     t = np.linspace(0, 2, 40001)
     s = r.sample(t)
     rate = s["v_M"] - s["v_m"]
     assert np.all(s["contact_force"][rate < -1e-9] == 0.0)
     for seg in r.segments:
-        if seg.mode.contact == "stick":
+        if seg.mode["contact"].phase == "stick":
             ts = np.linspace(seg.t0, seg.t1, 50)
             y = r.state(ts)
             assert np.max(np.abs(y[1] - y[3])) < 1e-12
@@ -196,9 +191,10 @@ def test_clipped_force_region():
                   absorber=Absorber(mass=1000.0, mount="ground", stiffness=13500.0, damping=3675.0),
                   contact=Contact(gap=0.0, stiffness=2.1e8, exponent=1.3, damping_factor=5.0))
     r = solve_reference(scene, 1.0)
-    clipped = [s for s in r.segments if s.mode.contact == "off" and s.mode.penetrated]
+    clipped = [s for s in r.segments if s.mode["contact"].phase == "off" and s.mode["contact"].penetrated]
     assert len(clipped) == 1
     seg = clipped[0]
+    assert seg.mode["contact"].clipped
     ts = np.linspace(seg.t0, seg.t1, 101)
     assert np.all(r.penetration(ts[:-1]) > 0) and np.all(r.contact_force(ts) == 0.0)
     rate = r.barrel_velocity(seg.t0) - r.absorber_velocity(seg.t0)
@@ -266,19 +262,6 @@ def test_bad_arguments():
         solve_reference("model_ii.toml", 1.0)
 
 
-def test_import_does_not_load_exudyn_or_engine():
-    code = ("import sys, validation, validation.reference, validation.reference.closed_form, validation.studies.paper\n"
-            "bad = [m for m in sys.modules if m == 'exudyn' or m.startswith('exudyn.') or m in "
-            "('mbs_models.engine.simulation', 'mbs_models.engine.assembly', 'mbs_models.forces', 'mbs_models.results.result', "
-            "'mbs_models.results.peaks', 'mbs_models.engine.accuracy', 'mbs_models.cli')]\n"
-            "print(bad)\n"
-            "sys.exit(1 if bad else 0)\n")
-    env = dict(os.environ, PYTHONPATH=str(REPO) + os.pathsep + os.environ.get("PYTHONPATH", ""))
-    out = subprocess.run([sys.executable, "-c", code], cwd=REPO, env=env, capture_output=True, text=True,
-                         timeout=60)
-    assert out.returncode == 0, out.stdout + out.stderr
-
-
 # ------------------------------------------------------------------ the paper's m = 1000 kg case
 @pytest.mark.parametrize("model", ["i", "ii"])
 def test_paper_case_m1000_gap0(model):
@@ -296,45 +279,3 @@ def test_paper_case_m1000_gap0(model):
         assert r.max_barrel_displacement == pytest.approx(0.2066, abs=5e-4)
     assert 115e3 < r.peak_contact_force < 130e3
     assert first.start == 0.0 and 0.012 < first.end < 0.018
-
-
-@pytest.mark.parametrize("scene", [simplified_model(), model_i(500.0, 0.01), model_ii(100.0, 0.0),
-                                   model_ii(1000.0, 0.02, Conventions(literal_gap_sign=True, literal_lambda_sign=True))],
-                         ids=["simplified", "i", "ii", "ii-literal"])
-def test_rhs_is_the_equations_written_out(scene):
-    """The fast scalar right-hand side equals the equations' building blocks (accelerations from
-    other_forces / raw_contact_force, dissipated powers c v^2, c_r v_rel^2 and (F - k_c p^n) p') in
-    every mode, bit for bit, on random states."""
-    from validation.reference import equations as eq
-
-    P = eq.Parameters.from_scene(scene)
-    rng = np.random.default_rng(7)
-    for contact in (eq.OFF, eq.ON, eq.STICK) if P.has_absorber else (eq.OFF,):
-        for recoil in (True, False):
-            for penetrated in (False, True):
-                mode = eq.Mode(contact=contact, recoil=recoil, penetrated=penetrated)
-                for _ in range(200):
-                    y = rng.normal(size=7) * np.array([0.05, 1.0, 0.05, 1.0, 10.0, 10.0, 10.0])
-                    a_M, a_m = eq.accelerations(P, y, mode)
-                    F = eq.raw_contact_force(P, y, mode)
-                    expected = [y[1], a_M, y[3], a_m if P.has_absorber else 0.0, mode.damping(P) * y[1] ** 2]
-                    if P.has_absorber:
-                        _, rel_v = eq.absorber_relative(P, y)
-                        p, pd = eq.penetration(P, y), eq.penetration_rate(P, y)
-                        elastic = P.kc * eq.signed_power(p, P.n) if (penetrated or contact != eq.OFF) else 0.0
-                        expected += [P.cr * rel_v ** 2, (F - elastic) * pd]
-                    else:
-                        expected += [0.0, 0.0]
-                    np.testing.assert_array_equal(eq.rhs(P, mode, 0.0, y), np.array(expected, dtype=float),
-                                                  err_msg=str((contact, recoil, penetrated, y)))
-
-
-def test_rhs_overflow_gives_inf_like_numpy():
-    """A rejected trial step can visit absurd states: the right-hand side must give inf there (so the
-    integrator shrinks the step), as numpy arithmetic does, not raise OverflowError."""
-    from validation.reference import equations as eq
-
-    P = eq.Parameters.from_scene(model_ii(1.0, 0.0).with_changes(**{"contact.stiffness": 1e12}))
-    mode = eq.Mode(contact=eq.ON, recoil=True, penetrated=True)
-    dy = eq.rhs(P, mode, 0.0, np.array([1e200, 1e200, -1e200, 0.0, 0.0, 0.0, 0.0]))
-    assert dy.shape == (7,) and not np.all(np.isfinite(dy))

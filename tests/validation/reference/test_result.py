@@ -1,0 +1,213 @@
+"""The reference result's outputs (validation.reference.result): names, histories, support force, energies,
+per-contact, per-absorber and per-stop metrics, against definitions and conservation laws."""
+
+from __future__ import annotations
+
+import functools
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mbs_models.scene import load_scene, model_i, model_ii, simplified_model
+from validation.reference import solve_reference
+
+END = 2.0
+
+
+#: two absorbers (front: ground, hunt-crossley, gap 0; rear: barrel, lankarani-nikravesh, gap 10 mm), both stops
+WITH_STOPS = load_scene(Path(__file__).parent / "data" / "two_absorbers_stops.toml")
+TWO = WITH_STOPS.with_changes(recoil_stop=None, battery_stop=None)
+STOPS = dict(recoil_stop=WITH_STOPS.recoil_stop, battery_stop=WITH_STOPS.battery_stop)
+
+SCENES = {
+    "simplified": simplified_model(),
+    "i": model_i(500.0, 0.0),
+    "ii": model_ii(1000.0, 0.04),
+    "two-absorbers": TWO,
+    "two-absorbers-stops": WITH_STOPS,
+    "ii-stops": model_ii(100.0, 0.0).with_changes(**STOPS),
+}
+
+
+@functools.lru_cache(maxsize=None)
+def solved(key: str):
+    return solve_reference(SCENES[key], END)
+
+
+def grid(n=4001):
+    return np.linspace(0.0, END, n)
+
+
+def test_names_follow_design():
+    r = solved("two-absorbers-stops")
+    assert r.bodies == ("barrel", "front", "rear")
+    assert r.connectors == ("recoil_spring", "recoil_damper", "front_damper", "front_contact", "rear_damper",
+                            "rear_contact", "recoil_stop", "battery_stop")
+    assert set(r.contacts) == {"front_contact", "rear_contact", "recoil_stop", "battery_stop"}
+    assert [m.name for m in r.absorber_metrics] == ["front", "rear"] and set(r.stop_metrics) == {"recoil_stop",
+                                                                                                 "battery_stop"}
+    assert set(r.dissipated_energy) == {"recoil_damper", "front_damper", "front_contact", "rear_damper",
+                                        "rear_contact", "recoil_stop", "battery_stop"}
+    assert set(r.stored_energy(0.1)) == {"recoil_spring", "front_damper", "front_contact", "rear_damper",
+                                         "rear_contact", "recoil_stop", "battery_stop"}
+    assert set(r.kinetic_energy(0.1)) == {"barrel", "front", "rear"}
+    one = solved("ii")
+    assert one.bodies == ("barrel", "absorber") and one.connectors[-2:] == ("absorber_damper", "contact")
+    assert solved("simplified").bodies == ("barrel",) and solved("simplified").connectors == ("recoil_spring",
+                                                                                              "recoil_damper")
+
+
+@pytest.mark.parametrize("key", list(SCENES))
+def test_histories_are_derivatives_of_each_other(key):
+    r = solved(key)
+    t = grid(20001)
+    h = t[1] - t[0]
+    for body in r.bodies:
+        x, v, a = r.position(body, t), r.velocity(body, t), r.acceleration(body, t)
+        scale_v, scale_a = np.max(np.abs(v)) + 1e-9, np.max(np.abs(a)) + 1e-9
+        np.testing.assert_allclose(np.gradient(x, h)[1:-1], v[1:-1], atol=1e-3 * scale_v, err_msg=body)
+        smooth = np.abs(np.gradient(v, h) - a) < 1e-2 * scale_a  # velocity kinks at impacts are excluded
+        assert smooth.mean() > 0.97, body
+
+
+@pytest.mark.parametrize("key", list(SCENES))
+def test_support_force_is_minus_the_rate_of_momentum(key):
+    """With no external force S = -(M a_M + sum m_i a_i), to round-off of the forces."""
+    r = solved(key)
+    t = grid()
+    momentum_rate = sum(mass * r.acceleration(b, t) for b, mass in zip(r.bodies, [b.mass for b in r.model.bodies]))
+    scale = max(np.max(np.abs(r.connector_force(c, t))) for c in r.connectors)
+    np.testing.assert_allclose(r.support_force(t), -momentum_rate, rtol=0, atol=1e-9 * scale)
+
+
+def test_support_force_is_the_grounded_connectors_forces():
+    r = solved("ii-stops")
+    t = grid()
+    x, v, x_m, v_m = r.position("barrel", t), r.velocity("barrel", t), r.position("absorber", t), r.velocity("absorber", t)
+    c = np.where(v > 0, 6239.0, 14050.0)
+    expected = 27500.0 * x + c * v + 13500.0 * x_m + 3675.0 * v_m \
+        + r.connector_force("recoil_stop", t) - r.connector_force("battery_stop", t)
+    np.testing.assert_allclose(r.support_force(t), expected, rtol=1e-12, atol=1e-9 * np.max(np.abs(expected)))
+    assert np.any(r.connector_force("recoil_stop", t) > 0) and np.any(r.connector_force("battery_stop", t) > 0)
+
+
+@pytest.mark.parametrize("key", list(SCENES))
+def test_peak_support_force_is_refined(key):
+    r = solved(key)
+    t = grid(40001)
+    s = np.abs(r.support_force(t))
+    assert r.peak_support_force >= s.max() and r.peak_support_force >= 0
+    assert r.peak_support_force == pytest.approx(s.max(), rel=1e-4)
+    assert abs(r.support_force(r.time_of_peak_support_force)) == pytest.approx(r.peak_support_force, rel=1e-12)
+
+
+@pytest.mark.parametrize("key", list(SCENES))
+def test_energy_balance_closes_part_by_part(key):
+    r = solved(key)
+    t = grid()
+    total = sum(r.kinetic_energy(t).values()) + sum(r.stored_energy(t).values()) + \
+        sum(r.dissipated_energy_history(t).values())
+    np.testing.assert_allclose(total, r.energy_balance(t), rtol=1e-13)
+    assert r.initial_energy == pytest.approx(0.5 * SCENES[key].barrel.mass * SCENES[key].initial_velocity ** 2,
+                                             rel=1e-15)
+    assert np.max(np.abs(total - r.initial_energy)) < 1e-7 * r.initial_energy
+    for name, history in r.dissipated_energy_history(t).items():
+        assert np.all(np.diff(history) >= -1e-9 * r.initial_energy), name  # every connector only dissipates
+
+
+def test_absorber_specific_outputs_need_one_absorber():
+    r = solved("two-absorbers")
+    for call in (lambda: r.absorber_position(0.1), lambda: r.penetration(0.1), lambda: r.contact_force(0.1),
+                 lambda: r.accelerations(0.1), lambda: r.contact_episodes, lambda: r.absorber_velocity(0.1)):
+        with pytest.raises(ValueError, match="2 absorbers"):
+            call()
+    simple = solved("simplified")
+    assert simple.contact_force(0.3) == 0.0 and simple.accelerations(0.3).shape == (2,)
+    assert simple.peak_contact_force is None and simple.max_absorber_velocity is None and simple.impacts == []
+    assert simple.absorber_metrics == [] and simple.contacts == {} and simple.stop_metrics == {}
+
+
+def test_largest_over_absorbers_and_impacts_in_time_order():
+    r = solved("two-absorbers-stops")
+    per = {m.name: m for m in r.absorber_metrics}
+    assert r.peak_contact_force == max(m.peak_contact_force for m in per.values())
+    assert r.max_absorber_velocity == max(m.max_velocity for m in per.values())
+    best = max(per.values(), key=lambda m: m.peak_contact_force)
+    assert r.time_of_peak_contact_force == best.time_of_peak_contact_force
+    assert r.connector_force(f"{best.name}_contact", r.time_of_peak_contact_force) == pytest.approx(
+        r.peak_contact_force, rel=1e-12)
+    for m in per.values():
+        assert r.velocity(m.name, m.time_of_max_velocity) == pytest.approx(m.max_velocity, rel=1e-12)
+        assert r.acceleration(m.name, m.time_of_max_velocity) == pytest.approx(0.0, abs=1e-6)
+        assert m.impacts == r.contacts[f"{m.name}_contact"].impacts
+    starts = [i.start for i in r.impacts]
+    assert starts == sorted(starts)
+    assert sorted((i.start, i.contact) for i in r.impacts) == sorted(
+        (i.start, i.contact) for m in per.values() for i in m.impacts)
+    assert {i.contact for i in r.impacts} == {"front_contact", "rear_contact"}  # both absorbers are hit
+    for stop in r.stop_metrics.values():  # stops are not absorbers' impacts
+        assert all(i.contact == stop.name for i in stop.impacts)
+        assert stop.dissipated_energy == r.dissipated_energy[stop.name] > 0
+
+
+def test_contact_episodes_and_onsets():
+    r = solved("two-absorbers-stops")
+    t = grid(40001)
+    for name, contact in r.contacts.items():
+        force = r.connector_force(name, t)
+        assert np.all(force >= 0), name
+        for e in contact.episodes:
+            assert e.start <= e.time_of_peak <= e.end and e.contact == name
+            assert r.connector_force(name, e.time_of_peak) == pytest.approx(e.peak_force, rel=1e-12)
+            inside = (t > e.start) & (t < e.end)
+            assert np.all(force[inside] <= e.peak_force * (1 + 1e-12))
+        for a, b in zip(contact.episodes, contact.episodes[1:]):
+            assert a.end <= b.start
+        assert contact.impacts == [e for e in contact.episodes if e.peak_force > 1000.0]
+        c = r.model.connector(name)
+        for time, v_minus in contact.onsets:  # onset: p = 0 turning positive at the rate v-
+            assert abs(c.d_of(r.state(time)) - c.offset) < 1e-12
+            assert c.rate_of(r.state(time)) == pytest.approx(v_minus, rel=1e-9, abs=1e-12)
+        assert len(contact.onsets) >= len(contact.episodes) > 0
+
+
+def test_restitution_laws_use_the_onset_rate_of_their_episode():
+    """Lankarani-Nikravesh: F = k p^n (1 + chi p'/v^), chi = 3 (1 - e^2)/4, v^ = max(v-, 1 mm/s)."""
+    r = solved("two-absorbers")
+    chi = 3 * (1 - 0.5 ** 2) / 4
+    onsets = r.contacts["rear_contact"].onsets
+    assert onsets
+    c = r.model.connector("rear_contact")
+    for start, v_minus in onsets:
+        episode = next(e for e in r.contacts["rear_contact"].episodes if e.start == start)
+        t = np.linspace(episode.start, episode.end, 50)[1:-1]
+        y = r.state(t)
+        p, rate = c.d_of(y) - c.offset, c.rate_of(y)
+        expected = np.maximum(1e8 * np.maximum(p, 0) ** 1.5 * (1 + chi * rate / max(v_minus, 1e-3)), 0)
+        np.testing.assert_allclose(r.connector_force("rear_contact", t), expected, rtol=1e-12,
+                                   atol=1e-12 * episode.peak_force)
+
+
+def test_metrics_dictionary():
+    m = solved("two-absorbers-stops").metrics()
+    for key in ("max_barrel_displacement", "time_of_max_barrel_displacement", "peak_contact_force",
+                "time_of_peak_contact_force", "max_absorber_velocity", "time_of_max_absorber_velocity", "impacts",
+                "peak_support_force", "time_of_peak_support_force", "absorbers", "stops", "end_time",
+                "requested_end_time", "stop_reason", "final_metrics", "dissipated_energy", "wall_time"):
+        assert key in m, key
+    assert [a["name"] for a in m["absorbers"]] == ["front", "rear"]
+    assert set(m["stops"]) == {"recoil_stop", "battery_stop"}
+    assert set(m["impacts"][0]) == {"start", "end", "peak_force", "time_of_peak", "contact"}
+    assert m["stops"]["recoil_stop"]["dissipated_energy"] > 0
+    import json
+    json.dumps(m)  # plain values
+
+
+def test_sample_keys():
+    s = solved("ii").sample(11)
+    for key in ("t", "x_M", "v_M", "x_m", "v_m", "contact_force", "penetration", "support_force", "x:absorber",
+                "F:contact", "E_recoil_damper", "E_absorber_damper", "E_contact"):
+        assert s[key].shape == (11,), key
+    several = solved("two-absorbers").sample(5)
+    assert "x_m" not in several and several["x:rear"].shape == (5,)

@@ -1,0 +1,56 @@
+"""From a scene to the reference's :class:`~validation.reference.model.Model`, by the terms.
+
+The scene is read as data (duck typing, no import of the engine): ``scene.tables()`` lists what it has
+as ``(key, table)``; each table is given to the term of its name (the key without an index:
+``absorber.1`` -> ``absorber``) in :data:`validation.reference.terms.TERMS`.  A table without a term is an
+error: the reference would silently leave an effect out.
+"""
+
+from __future__ import annotations
+
+from .model import BARREL, AbsorberRole, Body, Connector, Model, ReferenceModelError
+from .terms import TERMS
+
+
+class ModelBuilder:
+    """What the terms add while a scene is read: bodies, connectors, absorbers and stops (by name)."""
+
+    def __init__(self, scene):
+        self.scene = scene
+        self.bodies: list[Body] = []
+        self.connectors: list[Connector] = []
+        self.absorbers: list[AbsorberRole] = []
+        self.stops: list[str] = []
+
+    def add_body(self, body: Body) -> None:
+        self.bodies.append(body)
+
+    def add_connector(self, connector: Connector) -> None:
+        self.connectors.append(connector)
+
+    def add_absorber(self, role: AbsorberRole) -> None:
+        self.absorbers.append(role)
+
+    def add_stop(self, name: str) -> None:
+        self.stops.append(name)
+
+    def model(self) -> Model:
+        """The model: the barrel first, then the other bodies in the order they were added."""
+        bodies = sorted(self.bodies, key=lambda b: b.name != BARREL)
+        return Model(getattr(self.scene, "name", ""), bodies, self.connectors, self.absorbers, self.stops)
+
+
+def table_name(key: str) -> str:
+    """The table's name of a scene key: ``absorber.1`` -> ``absorber``."""
+    return key.split(".")[0]
+
+
+def build_model(scene) -> Model:
+    """The reference model of ``scene`` (ReferenceModelError for a table without a reference term)."""
+    builder = ModelBuilder(scene)
+    for key, table in scene.tables():
+        term = TERMS.get(table_name(key))
+        if term is None:
+            raise ReferenceModelError(f"no reference term for [{table_name(key)}] (known: {', '.join(sorted(TERMS))})")
+        term.build(builder, key, table)
+    return builder.model()

@@ -1,0 +1,83 @@
+"""The equations of one mode, compiled into one straight-line Python function.
+
+The integrator calls the right-hand side ~10^4-10^5 times per run: one Python call per connector (or
+numpy scalar arithmetic, 5x slower still) would dominate the run.  So each connector gives its force
+in a state as a few lines of source (:class:`~validation.reference.model.Equations`) and this module
+joins them, for one :class:`~validation.reference.model.Mode`, into one function::
+
+    x0, v0, x1, v1, _, _, _ = y.tolist()       # positions and velocities of the bodies
+    f0 = f1 = fg = 0.0                         # forces on the bodies and on the ground
+    <connector 0: sets F0 (and P0)>;  fg += F0;  f0 -= F0      # F pushes b to -x, a to +x
+    ...                                        # constraints (a sliding contact) last
+    return array([v0, f0 / M, v1, f1 / m, P1, P2, P3])
+
+Kinds: ``"rhs"`` (Python floats; ``dy/dt``, inf where the arithmetic overflows, as numpy would give),
+``"scalar"`` and ``"array"`` (one state on Python floats, or numpy rows: the raw forces, the
+accelerations and the support force ``fg`` = S; ``omit`` leaves one connector out).  The same source
+serves all three: only ``copysign`` differs (``math`` or ``numpy``).  Constants are written with
+``repr`` (exact).  ``source(...)`` shows the code of a mode.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+_NAMESPACES = {
+    "rhs": {"copysign": math.copysign, "array": np.array, "full": np.full, "inf": math.inf},
+    "scalar": {"copysign": math.copysign},
+    "array": {"copysign": np.copysign},
+}
+
+
+def _point(model, body) -> tuple[str, str, str]:
+    """(position, velocity, force accumulator) names of a connector end (the ground: 0.0, 0.0, fg)."""
+    if body is None:
+        return "0.0", "0.0", "fg"
+    return f"x{body}", f"v{body}", f"f{body}"
+
+
+def source(model, mode, kind: str, omit: int | None = None) -> str:
+    """The Python source of ``kind`` (module docstring) for ``mode`` of ``model``."""
+    nb = model.n_bodies
+    names = [n for i in range(nb) for n in (f"x{i}", f"v{i}")] + ["_"] * (model.n_states - 2 * nb)
+    unpack = "y" if kind == "array" else "y.tolist()"
+    body = [f"{', '.join(names)}, = {unpack}", " = ".join([f"f{i}" for i in range(nb)] + ["fg", "0.0"])]
+    blocks, late = [], []
+    forces, powers = {}, {}
+    for j, (c, state) in enumerate(zip(model.connectors, mode.states)):
+        equations = None if j == omit else c.equations(state)
+        if equations is None:
+            continue
+        xa, va, fa = _point(model, c.body_a)
+        xb, vb, fb = _point(model, c.body_b)
+        fields = {k: repr(float(v)) for k, v in equations.constants.items()}
+        code = equations.code.format(xa=xa, xb=xb, va=va, vb=vb, fa=fa, fb=fb, F=f"F{j}", P=f"P{j}", **fields)
+        lines = [f"# {c.name}: {state!r}"] + [line.strip() for line in code.strip().splitlines()]
+        lines += [f"{fa} += F{j}", f"{fb} -= F{j}"]
+        (late if equations.constraint else blocks).append(lines)
+        forces[j] = f"F{j}"
+        if c.dissipates and "{P}" in equations.code:
+            powers[j] = f"P{j}"
+    for lines in blocks + late:
+        body += lines
+    accelerations = [f"f{i} / {model.masses[i]!r}" for i in range(nb)]
+    if kind == "rhs":
+        derivative = [x for i in range(nb) for x in (f"v{i}", accelerations[i])]
+        derivative += [powers.get(c.index, "0.0") for c in model.dissipating]
+        body.append(f"return array([{', '.join(derivative)}])")
+        inner = "\n".join("        " + line for line in body)
+        return (f"def rhs(t, y):\n    try:\n{inner}\n    except OverflowError:\n"
+                f"        return full({model.n_states}, inf)\n")
+    all_forces = [forces.get(j, "0.0") for j in range(len(model.connectors))]
+    body.append(f"return [{', '.join(all_forces)}], [{', '.join(accelerations)}], fg")
+    return "def evaluate(y):\n" + "\n".join("    " + line for line in body) + "\n"
+
+
+def compile_mode(model, mode, kind: str, omit: int | None = None):
+    """The function of ``kind`` for ``mode`` (see the module docstring)."""
+    namespace = dict(_NAMESPACES[kind])
+    text = source(model, mode, kind, omit)
+    exec(compile(text, f"<reference {kind} of {mode!r}>", "exec"), namespace)  # noqa: S102 - our own source
+    return namespace["rhs" if kind == "rhs" else "evaluate"]

@@ -1,0 +1,52 @@
+"""Reference terms: one module per physical effect, found by this package.
+
+A term module names the scene tables it models in ``TABLES`` and adds, in ``build(builder, key, table)``,
+the bodies, connectors and roles of one such table to a
+:class:`~validation.reference.assembly.ModelBuilder` (``key`` is the table's place in the scene:
+``"recoil_spring"``, ``"absorber"``, ``"absorber.1"``).  The connectors carry the rest of the effect:
+the force on the bodies as a function of the state, the stored energy and dissipated power, the
+switching surfaces and how the mode is classified at a restart, and the contribution to the energy
+bounds of the early stop (:mod:`validation.reference.model`).  Adding an effect to the reference is
+adding one module here.
+
+Modules without ``TABLES`` are building blocks of the terms (:mod:`.contact_laws`, :mod:`.spring_damper`).
+
+========================  ==========================================================================
+module                    effect (tables)
+========================  ==========================================================================
+:mod:`.barrel`            the recoiling barrel, its initial velocity ``[barrel]``
+:mod:`.firing`            the shot's momentum: v0 ``[firing]``
+:mod:`.recoil_spring`     linear spring ground -> barrel ``[recoil_spring]``
+:mod:`.recoil_damper`     asymmetric damper ground -> barrel ``[recoil_damper]``
+:mod:`.absorber`          absorbers: body, actuator, contact with wall A ``[[absorber]]``
+:mod:`.end_stops`         the barrel against the ground ``[recoil_stop]``, ``[battery_stop]``
+:mod:`.contact_laws`      (building block) the contact-law family of every contact
+:mod:`.spring_damper`     (building block) the linear spring-damper ``F = k d + c d'``
+========================  ==========================================================================
+"""
+
+from __future__ import annotations
+
+import importlib
+import pkgutil
+from types import ModuleType
+
+
+def _discover() -> dict[str, ModuleType]:
+    """Every term module of this package, by the table names it declares in ``TABLES``."""
+    found: dict[str, ModuleType] = {}
+    for info in sorted(pkgutil.iter_modules(__path__), key=lambda i: i.name):
+        if info.name.startswith("_"):
+            continue
+        module = importlib.import_module(f"{__name__}.{info.name}")
+        for table in getattr(module, "TABLES", ()):
+            if table in found:
+                raise RuntimeError(f"two reference terms for [{table}]: {found[table].__name__} and {module.__name__}")
+            found[table] = module
+    return found
+
+
+#: table name -> term module
+TERMS: dict[str, ModuleType] = _discover()
+
+__all__ = ["TERMS"]
