@@ -11,8 +11,7 @@ import pytest
 
 from mbs_models import model_i, model_ii, simplified_model
 from mbs_models.cli import main
-from validation.reference import equations as eq
-from validation.studies.precision import (FAILED_STATUSES, METRICS, TARGETS, RunValues, Setting, Study, _exudyn, _scipy,
+from validation.studies.precision import (Parameters, FAILED_STATUSES, METRICS, TARGETS, RunValues, Setting, Study, _exudyn, _scipy,
                                   classify_failure, compute_truth, impact_mismatch, plain_rhs, run_study)
 
 END_TIME = 1.0  # the first impacts of model (ii), m = 1000 kg, gap 0, happen in the first second
@@ -98,17 +97,18 @@ def test_simplified_scene_has_no_contact_metrics():
 
 @pytest.mark.parametrize("scene", [model_i(500.0, 0.0), model_ii(100.0, 0.01)], ids=["model-i", "model-ii"])
 def test_plain_rhs_is_the_reference_equations(scene):
-    """scipy's plain right-hand side equals validation.reference.equations' in the mode the state is in."""
-    P = eq.Parameters.from_scene(scene)
-    f = plain_rhs(P)
+    """scipy's plain right-hand side equals the reference's in the mode the state is in (classified by the
+    reference itself at a restart from that state)."""
+    from validation.reference.assembly import build_model
+    from validation.reference.switching import Restart
+
+    f = plain_rhs(Parameters.from_scene(scene))
+    model = build_model(scene)
     rng = np.random.default_rng(1)
     for _ in range(200):
-        y = np.concatenate([rng.normal(0, 0.01, 4) * [1, 50, 1, 50], np.zeros(3)])
-        penetration = eq.penetration(P, y)
-        force = max(0.0, P.kc * max(penetration, 0.0) ** P.n * eq.damping_term(P, y))
-        contact = eq.ON if penetration > 0 and force > 0 else eq.OFF
-        mode = eq.Mode(contact, bool(y[1] > 0), bool(penetration > 0))
-        np.testing.assert_allclose(f(0.0, y[:4]), eq.rhs(P, mode, 0.0, y)[:4], rtol=1e-12, atol=1e-9)
+        y = np.concatenate([rng.normal(0, 0.01, 4) * [1, 50, 1, 50], np.zeros(model.n_states - 4)])
+        mode = Restart(model, 0.0, y, {}, None).mode
+        np.testing.assert_allclose(f(0.0, y[:4]), model.rhs(mode)(0.0, y)[:4], rtol=1e-12, atol=1e-9)
 
 
 def test_failure_classification():
