@@ -1,4 +1,7 @@
-"""Shared fixtures: paper scenes as TOML mappings, and the table of bad-scene cases."""
+"""Shared fixtures: paper scenes as TOML mappings, the table of bad-scene cases, a scene of every element
+composed from the shipped examples (``every_element``) and DESIGN.md's names and contact laws written out for the
+reference's tests (``design_connectors``, ``design``, ``assert_sound``).  Nothing here names an effect beyond
+the paper's: an effect's own tests are in its test file (tests/elements/)."""
 
 from __future__ import annotations
 
@@ -170,3 +173,193 @@ def changed():
     def apply(mapping: dict, path: str, value) -> dict:
         return delete(path)(mapping) if value == DELETED else edit(path, value)(mapping)
     return apply
+
+
+# ------------------------------------------------------------------ a scene of every element, composed generically
+def _shipped_scenes() -> list:
+    from mbs_models import load_scene
+    from mbs_models.scenes import list_scenes
+
+    return [load_scene(scene_path(name)) for name in list_scenes()]
+
+
+def with_every_element(scene=None, **law):
+    """``scene`` (default: the shipped scene with the most absorbers) with every single (non-array) table of
+    the shipped example scenes that it lacks, each as the first shipped scene (by name) that has it gives it.
+    The shipped examples together have every element table of the library (test_terms.py checks it), so the
+    result is a scene of every element, composed without naming one.  ``law`` (e.g. ``law="hertz",
+    stiffness=1e9, exponent=1.5``): every added table with a contact law takes that law and those fields."""
+    from dataclasses import replace
+
+    from mbs_models.elements import ELEMENT_TABLES
+    from mbs_models.elements.contact_laws import LAW_FIELDS, LawFields
+
+    shipped = _shipped_scenes()
+    scene = max(shipped, key=lambda s: len(s.absorbers)) if scene is None else scene
+    added: dict = {}
+    for other in shipped:
+        for key, table in other.tables():
+            if key in ELEMENT_TABLES and not ELEMENT_TABLES[key].MANY and getattr(scene, key) is None:
+                added.setdefault(key, table)
+    if law:
+        added = {key: replace(table, **{**dict.fromkeys(LAW_FIELDS), **law}) if isinstance(table, LawFields) else table
+                 for key, table in added.items()}
+    return scene.with_changes(**added)
+
+
+@pytest.fixture(scope="session")
+def every_element():
+    """``every_element(scene=None, **law)``: see :func:`with_every_element`."""
+    return with_every_element
+
+
+def design_connector_names(scene) -> tuple[str, ...]:
+    """DESIGN.md's connector names of ``scene`` in assembly order: ``recoil_spring`` and ``recoil_damper``, an
+    absorber's ``<name>_damper`` and ``<name>_contact`` (``absorber_damper`` and ``contact`` with one absorber),
+    and for every other table but the barrel and the firing one connector named like its table.  (Every
+    coefficient non-zero: a zero spring or damper adds no connector.)"""
+    several = len(scene.absorbers) > 1
+    absorbers = set(scene.absorber_names())
+    names: list[str] = []
+    for name, _ in scene.elements():
+        if name in absorbers:
+            names += [f"{name}_damper", f"{name}_contact"] if several else ["absorber_damper", "contact"]
+        elif name not in ("barrel", "firing"):
+            names.append(name)
+    return tuple(names)
+
+
+@pytest.fixture(scope="session")
+def design_connectors():
+    """``design_connectors(scene)``: see :func:`design_connector_names`."""
+    return design_connector_names
+
+
+# ------------------------------------------------------------------ DESIGN.md's contact laws, written out here
+def design_chi(law: str, e: float) -> float:
+    """chi of the restitution laws as DESIGN.md's table gives them (exact-restitution by bisection of its
+    defining relation chi - ln(1 + chi) = -chi e - ln(1 - chi e) on (0, 1/e))."""
+    if law == "lankarani-nikravesh":
+        return 3 * (1 - e * e) / 4
+    if law == "flores":
+        return 8 * (1 - e) / (5 * e)
+    if law == "gonthier":
+        return (1 - e * e) / e
+    lo, hi = 1e-12, (1 - 1e-15) / e
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if mid - math.log1p(mid) - (-mid * e - math.log1p(-mid * e)) > 0:
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+def design_law_force(table, p: float, rate: float, state, lam_sign: float = 1.0) -> tuple[float, float]:
+    """(F, elastic) of a contact table in a reference contact state: DESIGN.md's law, unclipped, on its
+    smooth extension."""
+    if state.phase == "off" and not state.penetrated:
+        return 0.0, 0.0
+    n = 1.0 if table.law == "kelvin-voigt" else table.exponent
+    elastic = table.stiffness * math.copysign(abs(p) ** n, p)
+    if state.phase == "off":
+        return 0.0, elastic
+    if table.law == "kelvin-voigt":
+        return elastic + table.damping * rate, elastic
+    if table.law == "hunt-crossley":
+        a = lam_sign * table.damping_factor
+    elif table.law == "hertz":
+        a = 0.0
+    else:
+        a = design_chi(table.law, table.restitution) / max(state.onset_rate, table.minimum_impact_velocity or 1e-3)
+    return elastic * (1 + a * rate), elastic
+
+
+def reference_modes(model) -> list:
+    """Every combination of a reference model's connector states worth checking (contacts x damper
+    branches; a fixed sample of 48 when there are more)."""
+    import itertools
+
+    import numpy as np
+
+    from validation.reference.model import Mode
+    from validation.reference.terms.contact_laws import ContactMode
+
+    options = []
+    for c in model.connectors:
+        if c.is_contact:
+            choices = [ContactMode("off"), ContactMode("off", True, True, 0.0, 0.3),
+                       ContactMode("on", True, False, c.law.episode_factor(0.3), 0.3),
+                       ContactMode("on", True, False, c.law.episode_factor(0.0), 0.0)]
+            if c.compression_only:
+                choices.append(ContactMode("stick", True, False, c.law.damping_factor, 0.3))
+            options.append(choices)
+        elif c.classify_pass == 2:
+            options.append([True, False])
+        else:
+            options.append([None])
+    modes = [Mode(model.names, states) for states in itertools.product(*options)]
+    if len(modes) > 48:  # a fixed sample of the combinations, always with the first and the last
+        keep = np.random.default_rng(3).choice(len(modes) - 2, 46, replace=False) + 1
+        modes = [modes[0], *(modes[k] for k in sorted(keep)), modes[-1]]
+    return modes
+
+
+def check_rhs_is(scene, design_rhs, label: str = "") -> None:
+    """The reference's fast right-hand side of ``scene`` (and its numpy twin, used in post-processing) equals
+    ``design_rhs(scene, y, states) -> (dy/dt of the bodies, dissipated power per connector)`` -- DESIGN.md's
+    equations written out in a test -- in every mode (:func:`reference_modes`), on random states."""
+    import numpy as np
+
+    from validation.reference.assembly import build_model
+
+    model = build_model(scene)
+    rng = np.random.default_rng(7)
+    nb = model.n_bodies
+    dissipating = [c.name for c in model.dissipating]
+    for mode in reference_modes(model):
+        states = dict(zip(mode.names, mode.states))
+        rhs = model.rhs(mode)
+        batch = []
+        for _ in range(30):
+            y = rng.normal(size=model.n_states) * np.array([0.05, 1.0] * nb + [10.0] * len(dissipating))
+            expected, power = design_rhs(scene, y, states)
+            assert sorted(power) == sorted(dissipating)
+            expected += [power.get(name, 0.0) for name in dissipating]
+            np.testing.assert_allclose(rhs(0.0, y), expected, rtol=1e-12, atol=1e-9, err_msg=f"{label} {mode}")
+            batch.append(y)
+        batch = np.array(batch).T
+        evaluation = model.evaluate(mode, batch)
+        for i in range(nb):
+            np.testing.assert_array_equal(evaluation.accelerations[i] + 0 * batch[0],
+                                          [rhs(0.0, y)[2 * i + 1] for y in batch.T])
+
+
+@pytest.fixture(scope="session")
+def design():
+    """DESIGN.md written out for the reference's tests: ``chi(law, e)``, ``law_force(table, p, rate, state,
+    lam_sign=1.0)``, ``modes(model)`` and ``check_rhs(scene, design_rhs, label)`` (see the functions above)."""
+    from types import SimpleNamespace
+
+    return SimpleNamespace(chi=design_chi, law_force=design_law_force, modes=reference_modes, check_rhs=check_rhs_is)
+
+
+# ------------------------------------------------------------------ a sound reference result
+def assert_sound_reference(r, end: float, balance: float = 1e-8) -> None:
+    """Finite, non-negative contact forces of a reference result over [0, end]; the energy balance closes
+    to ``balance`` of the initial energy (or of 1 J)."""
+    import numpy as np
+
+    t = np.linspace(0.0, end, 20001)
+    for name in r.contacts:
+        force = r.connector_force(name, t)
+        assert np.all(np.isfinite(force)) and np.all(force >= 0), name
+    energy = r.energy_balance(t)
+    assert np.all(np.isfinite(energy))
+    assert np.max(np.abs(energy - r.initial_energy)) <= balance * max(r.initial_energy, 1.0)
+
+
+@pytest.fixture(scope="session")
+def assert_sound():
+    """``assert_sound(reference_result, end, balance=1e-8)``: see :func:`assert_sound_reference`."""
+    return assert_sound_reference

@@ -1,14 +1,22 @@
-"""End stops (mbs_models.elements.end_stops): the barrel against the ground, any contact law."""
+"""End stops (mbs_models.elements.end_stops, validation/reference/terms/end_stops.py): the barrel against the
+ground, any contact law.  Everything particular to the stops: the engine's items, outputs and errors, the
+reference's equations, names and hard cases.  The generic tests (tests/validation/reference/, ...) run on
+scenes of every element that include the stops (the ``every_element`` fixture of tests/conftest.py; checked
+below)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy.optimize import minimize_scalar
 
-from mbs_models import BatteryStop, RecoilStop, load_scene, model_ii, simplified_model, simulate
+from mbs_models import (Barrel, BatteryStop, Firing, RecoilDamper, RecoilSpring, RecoilStop, Scene, load_scene,
+                        model_ii, simplified_model, simulate)
 from mbs_models.elements.contact_laws import CONTACT_LAWS
 from mbs_models.engine.assembly import assemble
 from mbs_models.scenes import scene_path
+from validation.reference import solve_reference
+from validation.reference.assembly import build_model
 
 LAW_FIELDS = {"hunt-crossley": dict(stiffness=1e9, exponent=1.5, damping_factor=0.5),
               "hertz": dict(stiffness=1e9, exponent=1.5), "kelvin-voigt": dict(stiffness=5e7, damping=2e5)}
@@ -97,3 +105,158 @@ def test_bad_stop_tables_are_one_line_errors_naming_the_key(bad_input, v2_mappin
 
 def test_stops_need_a_version_2_scene(bad_input, v1_mapping):
     bad_input(dict(v1_mapping, recoil_stop=STOP_TABLES["recoil_stop"]), "recoil_stop", "version-2 scene")
+
+
+# ------------------------------------------------------------------ the generic tests' scenes have the stops
+def test_the_scene_of_every_element_has_the_stops(every_element):
+    """The generic tests run on scenes composed by ``every_element``: with the shipped example's stops."""
+    shipped = load_scene(scene_path("end_stops"))
+    for base in (None, model_ii(100.0, 0.0)):
+        scene = every_element(base)
+        assert (scene.recoil_stop, scene.battery_stop) == (shipped.recoil_stop, shipped.battery_stop)
+
+
+# ------------------------------------------------------------------ the reference: equations and names
+def stops_design_rhs(scene, y, states, law_force):
+    """dy/dt and dissipated powers of DESIGN.md's equations for a barrel with a recoil spring, the recoil
+    damper and both stops: the recoil stop is a contact ground -> barrel with ``p = x_M - position`` (it
+    pushes the barrel towards -x), the battery stop barrel -> ground with ``p = position - x_M`` (towards +x);
+    ``law_force``: DESIGN.md's contact laws (the ``design`` fixture)."""
+    x, v = y[0], y[1]
+    damper = scene.recoil_damper
+    c = damper.recoil if states["recoil_damper"] is not False else damper.counter_recoil
+    f = -scene.recoil_spring.stiffness * x - c * v
+    power = {"recoil_damper": c * v ** 2}
+    for stop, sign in (("recoil_stop", 1.0), ("battery_stop", -1.0)):
+        table = getattr(scene, stop)
+        p, rate = sign * (x - table.position), sign * v
+        F, elastic = law_force(table, p, rate, states[stop])
+        f -= sign * F
+        power[stop] = (F - elastic) * rate
+    return [v, f / scene.barrel.mass], power
+
+
+PAPER_BARREL = dict(barrel=Barrel(5600.0), firing=Firing(6.86, 564.0), recoil_spring=RecoilSpring(27500.0),
+                    recoil_damper=RecoilDamper(6239.0, 14050.0))
+RHS_STOPS = {
+    "flores-kelvin-voigt": (dict(law="flores", stiffness=1e9, exponent=1.5, restitution=0.4),
+                            dict(law="kelvin-voigt", stiffness=5e7, damping=2e5)),
+    "hunt-crossley-hertz": (dict(law="hunt-crossley", stiffness=1e9, exponent=1.5, damping_factor=0.5),
+                            dict(law="hertz", stiffness=1e9, exponent=1.2)),
+    "exact-lankarani": (dict(law="exact-restitution", stiffness=1e9, exponent=1.5, restitution=0.3,
+                             minimum_impact_velocity=0.01),
+                        dict(law="lankarani-nikravesh", stiffness=1e8, exponent=1.3, restitution=0.6)),
+    "gonthier-gonthier": (dict(law="gonthier", stiffness=1e9, exponent=1.5, restitution=0.5),
+                          dict(law="gonthier", stiffness=1e8, exponent=1.0, restitution=0.7)),
+}
+
+
+@pytest.mark.parametrize("key", list(RHS_STOPS))
+def test_reference_rhs_is_the_design_equations_of_the_stops(key, design):
+    """The reference's right-hand side (and its numpy twin) of the barrel, its spring and damper and both stops
+    equals DESIGN.md's equations written out above, in every mode, on random states."""
+    recoil, battery = RHS_STOPS[key]
+    scene = Scene(**PAPER_BARREL, recoil_stop=RecoilStop(position=0.15, **recoil),
+                  battery_stop=BatteryStop(position=-0.01, **battery))
+    design.check_rhs(scene, lambda *args: stops_design_rhs(*args, law_force=design.law_force), key)
+
+
+def test_the_reference_names_the_stops_after_their_tables(every_element):
+    """DESIGN.md: the stops' connectors are named like their tables, after the absorbers' (assembly order);
+    both dissipate (one dissipated energy each in the state)."""
+    model = build_model(every_element())  # the shipped two absorbers and the shipped stops
+    assert [b.name for b in model.bodies] == ["barrel", "front", "rear"]
+    assert model.names == ("recoil_spring", "recoil_damper", "front_damper", "front_contact", "rear_damper",
+                           "rear_contact", "recoil_stop", "battery_stop")
+    assert [c.name for c in model.dissipating] == ["recoil_damper", "front_damper", "front_contact", "rear_damper",
+                                                   "rear_contact", "recoil_stop", "battery_stop"]
+    assert model.n_states == 2 * 3 + 7
+
+
+def test_an_unreachable_stop_changes_nothing():
+    plain = model_ii(1000.0, 0.0)
+    far = plain.with_changes(recoil_stop=RecoilStop(position=1.0, stiffness=1e9, exponent=1.5, damping_factor=0.5),
+                             battery_stop=BatteryStop(position=-1.0, law="hertz", stiffness=1e9, exponent=1.5))
+    a, b = solve_reference(plain, 3.0), solve_reference(far, 3.0)
+    for name in ("max_barrel_displacement", "peak_contact_force", "max_absorber_velocity", "peak_support_force"):
+        assert getattr(b, name) == pytest.approx(getattr(a, name), rel=1e-9, abs=1e-12)
+    assert set(b.stop_metrics) == {"recoil_stop", "battery_stop"}
+    assert all(m.episodes == [] and m.peak_force == 0.0 for m in b.stop_metrics.values())
+
+
+# ------------------------------------------------------------------ the reference: hard cases
+LN = dict(law="lankarani-nikravesh", stiffness=1e8, exponent=1.5, restitution=0.5)
+CHI = 3 * (1 - 0.5 ** 2) / 4   # Lankarani-Nikravesh's chi for e = 0.5
+FLOOR = 1e-3                   # the default minimum_impact_velocity, m/s
+
+
+def test_battery_stop_touching_a_barrel_at_rest(assert_sound):
+    """p = 0, p' = 0, p'' = 0 at the battery stop: nothing moves, no force, no division by v- = 0."""
+    scene = Scene(barrel=Barrel(5600.0, initial_velocity=0.0), recoil_spring=RecoilSpring(27500.0),
+                  recoil_damper=RecoilDamper(6239.0, 14050.0), battery_stop=BatteryStop(position=0.0, **LN))
+    r = solve_reference(scene, 1.0)
+    assert_sound(r, 1.0)
+    assert r.initial_energy == 0.0 and r.max_barrel_displacement == 0.0
+    assert r.stop_metrics["battery_stop"].peak_force == 0.0 and r.stop_metrics["battery_stop"].episodes == []
+    assert r.peak_support_force == 0.0
+
+
+def test_grazing_return_onto_the_battery_stop(assert_sound):
+    """The barrel returns past x = 0 and turns; a battery stop 2e-8 m short of that turning point is met at
+    v- ~ 2e-4 m/s, below minimum_impact_velocity: the law damps as Hunt-Crossley with lambda = chi / 1 mm/s,
+    the force stays finite and >= 0, and the energy balance closes."""
+    base = Scene(**PAPER_BARREL)
+    free = solve_reference(base, 4.0)
+    t = np.linspace(0.0, 4.0, 40001)
+    i = int(np.argmin(free.barrel_position(t)))
+    turn = minimize_scalar(free.barrel_position, bounds=(t[i - 1], t[i + 1]), method="bounded",
+                           options={"xatol": 1e-12})
+    x_min, a_turn = float(turn.fun), float(free.acceleration("barrel", turn.x))
+    v_target = 2e-4
+    position = x_min + v_target ** 2 / (2 * a_turn)
+    r = solve_reference(base.with_changes(battery_stop=BatteryStop(position=position, **LN)), 4.0)
+    onsets = r.contacts["battery_stop"].onsets
+    assert len(onsets) == 1
+    t_on, v_minus = onsets[0]
+    assert v_minus == pytest.approx(v_target, rel=0.05) and v_minus < FLOOR
+    state = next(s.mode["battery_stop"] for s in r.segments if s.t0 == t_on)
+    assert state.factor == pytest.approx(CHI / FLOOR, rel=1e-15)
+    assert_sound(r, 4.0)
+    stop = r.stop_metrics["battery_stop"]
+    assert 0 < stop.peak_force < 1000.0 and stop.impacts == []  # a touch, not an impact
+
+
+SPEED = 10  # times the paper's muzzle velocity: v0 = 6.9 m/s
+STOP_LAWS = {
+    "hunt-crossley": dict(law="hunt-crossley", stiffness=1e9, exponent=1.5, damping_factor=0.5),
+    "flores": dict(law="flores", stiffness=1e9, exponent=1.5, restitution=0.5),
+    "exact-restitution": dict(law="exact-restitution", stiffness=1e9, exponent=1.5, restitution=0.2),
+    "kelvin-voigt": dict(law="kelvin-voigt", stiffness=1e8, damping=1e6),
+    "hertz": dict(law="hertz", stiffness=1e9, exponent=1.5),
+}
+
+
+@pytest.mark.parametrize("law", list(STOP_LAWS))
+def test_reference_stops_hit_at_ten_times_the_firing_velocity(law, assert_sound):
+    scene = model_ii(1000.0, 0.0).with_changes(
+        firing=Firing(6.86, 564.0 * SPEED), recoil_stop=RecoilStop(position=0.15, **STOP_LAWS[law]),
+        battery_stop=BatteryStop(position=-0.05, law="kelvin-voigt", stiffness=5e7, damping=2e5))
+    end = 3.0
+    r = solve_reference(scene, end)
+    assert_sound(r, end, balance=1e-7)
+    energy = r.initial_energy
+    assert energy == pytest.approx(0.5 * 5600.0 * (6.86 * 5640.0 / 5600.0) ** 2, rel=1e-14)
+    stop = r.stop_metrics["recoil_stop"]
+    assert stop.impacts and stop.impacts[0].peak_force > 1e5
+    spec = STOP_LAWS[law]
+    n = spec.get("exponent", 1.0)
+    own = ((n + 1) * energy / spec["stiffness"]) ** (1 / (n + 1))  # the stop's potential cannot exceed E(0)
+    assert 0.15 < r.max_barrel_displacement < 0.15 + own
+    if law == "hertz":
+        assert stop.dissipated_energy == pytest.approx(0.0, abs=1e-8 * energy)
+    else:
+        assert stop.dissipated_energy > 0
+    t = np.linspace(0.0, end, 20001)
+    x = r.barrel_position(t)
+    np.testing.assert_array_equal(r.connector_force("recoil_stop", t)[x < 0.15 - 1e-12], 0.0)
+    np.testing.assert_array_equal(r.connector_force("battery_stop", t)[x > -0.05 + 1e-12], 0.0)

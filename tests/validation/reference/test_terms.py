@@ -3,7 +3,7 @@ equivalences between scenes that must move alike (split absorbers, laws that coi
 
 from __future__ import annotations
 
-import itertools
+import functools
 import math
 from types import SimpleNamespace
 
@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from mbs_models.elements import ELEMENT_TABLES
-from mbs_models.scene import (Absorber, Barrel, BatteryStop, Contact, Conventions, Firing, RecoilDamper, RecoilSpring,
-                              RecoilStop, Scene, model_i, model_ii, simplified_model)
+from mbs_models.scene import (Absorber, Barrel, Contact, Conventions, Firing, RecoilDamper, RecoilSpring, Scene,
+                              model_i, model_ii, simplified_model)
 from validation.reference import ReferenceModelError, solve_reference
 from validation.reference.assembly import build_model
 from validation.reference.model import Mode
@@ -31,51 +31,11 @@ def two_absorbers(front_contact=None, rear_contact=None, **tables) -> Scene:
                  recoil_damper=RecoilDamper(6239.0, 14050.0), absorbers=(front, rear), **tables)
 
 
-STOPS = dict(recoil_stop=RecoilStop(position=0.15, law="flores", stiffness=1e9, exponent=1.5, restitution=0.4),
-             battery_stop=BatteryStop(position=-0.01, law="kelvin-voigt", stiffness=5e7, damping=2e5))
-
-
 # ------------------------------------------------------------------ DESIGN.md's equations, written out here
-def _chi(law, e):
-    """chi of the restitution laws as DESIGN.md's table gives them (exact-restitution by bisection of its
-    defining relation chi - ln(1 + chi) = -chi e - ln(1 - chi e) on (0, 1/e))."""
-    if law == "lankarani-nikravesh":
-        return 3 * (1 - e * e) / 4
-    if law == "flores":
-        return 8 * (1 - e) / (5 * e)
-    if law == "gonthier":
-        return (1 - e * e) / e
-    lo, hi = 1e-12, (1 - 1e-15) / e
-    for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        if mid - math.log1p(mid) - (-mid * e - math.log1p(-mid * e)) > 0:
-            lo = mid
-        else:
-            hi = mid
-    return 0.5 * (lo + hi)
-
-
-def _law_force(table, p, rate, state, lam_sign=1.0):
-    """(F, elastic) of a contact table in a state: the unclipped law on its smooth extension."""
-    if state.phase == "off" and not state.penetrated:
-        return 0.0, 0.0
-    n = 1.0 if table.law == "kelvin-voigt" else table.exponent
-    elastic = table.stiffness * math.copysign(abs(p) ** n, p)
-    if state.phase == "off":
-        return 0.0, elastic
-    if table.law == "kelvin-voigt":
-        return elastic + table.damping * rate, elastic
-    if table.law == "hunt-crossley":
-        a = lam_sign * table.damping_factor
-    elif table.law == "hertz":
-        a = 0.0
-    else:
-        a = _chi(table.law, table.restitution) / max(state.onset_rate, table.minimum_impact_velocity or 1e-3)
-    return elastic * (1 + a * rate), elastic
-
-
-def design_rhs(scene, y, states):
-    """dy/dt of DESIGN.md's equations for ``scene`` in the mode ``states`` (connector name -> state)."""
+def design_rhs(scene, y, states, law_force):
+    """dy/dt of DESIGN.md's equations for ``scene`` in the mode ``states`` (connector name -> state): the
+    barrel, the recoil spring and damper, the absorbers and their contacts (``law_force``: DESIGN.md's
+    contact laws, the ``design`` fixture); another element's part is written out in its own test file."""
     absorbers, names = scene.absorbers, scene.absorber_names()
     several = len(absorbers) > 1
     nb = 1 + len(absorbers)
@@ -108,17 +68,10 @@ def design_rhs(scene, y, states):
         if states[contact].phase == "stick":
             sticking.append((i, contact, p, rate, a.contact))
             continue
-        F, elastic = _law_force(a.contact, p, rate, states[contact], lam_sign)
+        F, elastic = law_force(a.contact, p, rate, states[contact], lam_sign)
         f[i] += F
         f[0] -= F
         power[contact] = (F - elastic) * rate
-    for stop, sign in (("recoil_stop", 1.0), ("battery_stop", -1.0)):
-        table = getattr(scene, stop)
-        if table is not None:
-            p, rate = sign * (x[0] - table.position), sign * v[0]
-            F, elastic = _law_force(table, p, rate, states[stop])
-            f[0] -= sign * F
-            power[stop] = (F - elastic) * rate
     for i, contact, p, rate, table in sticking:
         m_red = masses[0] * masses[i] / (masses[0] + masses[i])
         F = m_red * (f[0] / masses[0] - f[i] / masses[i])
@@ -131,76 +84,38 @@ def design_rhs(scene, y, states):
     return out, power
 
 
-def _states_of(model):
-    """Every combination of connector states worth checking (contacts x damper branches)."""
-    options = []
-    for c in model.connectors:
-        if c.is_contact:
-            choices = [ContactMode("off"), ContactMode("off", True, True, 0.0, 0.3),
-                       ContactMode("on", True, False, c.law.episode_factor(0.3), 0.3),
-                       ContactMode("on", True, False, c.law.episode_factor(0.0), 0.0)]
-            if c.compression_only:
-                choices.append(ContactMode("stick", True, False, c.law.damping_factor, 0.3))
-            options.append(choices)
-        elif c.classify_pass == 2:
-            options.append([True, False])
-        else:
-            options.append([None])
-    modes = [Mode(model.names, states) for states in itertools.product(*options)]
-    if len(modes) > 48:  # a fixed sample of the combinations, always with the first and the last
-        keep = np.random.default_rng(3).choice(len(modes) - 2, 46, replace=False) + 1
-        modes = [modes[0], *(modes[k] for k in sorted(keep)), modes[-1]]
-    return modes
-
-
 RHS_SCENES = {
     "simplified": simplified_model(),
     "i": model_i(500.0, 0.01),
     "ii": model_ii(100.0, 0.0),
     "ii-literal": model_ii(1000.0, 0.02, Conventions(literal_gap_sign=True, literal_lambda_sign=True)),
     "ii-compression-only": model_ii(1000.0, 0.0, Conventions(compression_only=True)),
-    "two-absorbers-stops": two_absorbers(Contact(gap=0.0, law="gonthier", stiffness=1e8, exponent=1.5,
-                                                 restitution=0.5, minimum_impact_velocity=0.01), **STOPS),
+    "two-absorbers-gonthier": two_absorbers(Contact(gap=0.0, law="gonthier", stiffness=1e8, exponent=1.5,
+                                                    restitution=0.5, minimum_impact_velocity=0.01)),
     "hertz-exact": two_absorbers(Contact(gap=0.0, law="hertz", stiffness=1e8, exponent=1.5),
                                  Contact(gap=0.0, law="exact-restitution", stiffness=1e8, exponent=1.2, restitution=0.3)),
 }
 
 
 @pytest.mark.parametrize("key", list(RHS_SCENES))
-def test_rhs_is_the_design_equations(key):
+def test_rhs_is_the_design_equations(key, design):
     """The fast right-hand side (and its numpy twin, used in post-processing) equals DESIGN.md's equations
     written out here, in every mode, on random states."""
-    scene = RHS_SCENES[key]
-    model = build_model(scene)
-    rng = np.random.default_rng(7)
-    nb = model.n_bodies
-    dissipating = [c.name for c in model.dissipating]
-    for mode in _states_of(model):
-        states = dict(zip(mode.names, mode.states))
-        rhs = model.rhs(mode)
-        batch = []
-        for _ in range(30):
-            y = rng.normal(size=model.n_states) * np.array([0.05, 1.0] * nb + [10.0] * len(dissipating))
-            expected, power = design_rhs(scene, y, states)
-            assert sorted(power) == sorted(dissipating)
-            expected += [power.get(name, 0.0) for name in dissipating]
-            np.testing.assert_allclose(rhs(0.0, y), expected, rtol=1e-12, atol=1e-9, err_msg=f"{key} {mode}")
-            batch.append(y)
-        batch = np.array(batch).T
-        evaluation = model.evaluate(mode, batch)
-        for i in range(nb):
-            np.testing.assert_array_equal(evaluation.accelerations[i] + 0 * batch[0],
-                                          [rhs(0.0, y)[2 * i + 1] for y in batch.T])
+    design.check_rhs(RHS_SCENES[key], functools.partial(design_rhs, law_force=design.law_force), key)
 
 
-def test_state_layout_and_connector_names():
-    model = build_model(two_absorbers(**STOPS))
+def test_state_layout_and_connector_names(every_element, design_connectors):
+    model = build_model(two_absorbers())
     assert [b.name for b in model.bodies] == ["barrel", "front", "rear"]
     assert model.names == ("recoil_spring", "recoil_damper", "front_damper", "front_contact", "rear_damper",
-                           "rear_contact", "recoil_stop", "battery_stop")
+                           "rear_contact")
     assert [c.name for c in model.dissipating] == ["recoil_damper", "front_damper", "front_contact", "rear_damper",
-                                                   "rear_contact", "recoil_stop", "battery_stop"]
-    assert model.n_states == 2 * 3 + 7
+                                                   "rear_contact"]
+    assert model.n_states == 2 * 3 + 5  # positions and velocities, then one dissipated energy per dissipating connector
+    every = build_model(every_element(two_absorbers()))  # every other element: its connectors after the absorbers'
+    assert every.names == design_connectors(every_element(two_absorbers())) and every.names[:6] == model.names
+    assert [b.name for b in every.bodies] == ["barrel", "front", "rear"]
+    assert every.n_states == 2 * 3 + len(every.dissipating)
     one = build_model(model_ii())
     assert [b.name for b in one.bodies] == ["barrel", "absorber"]
     assert one.names == ("recoil_spring", "recoil_damper", "absorber_damper", "contact")
@@ -231,6 +146,13 @@ def test_initial_velocity_follows_design():
 # ------------------------------------------------------------------ every table has a term
 def test_every_scene_table_has_a_reference_term():
     assert set(ELEMENT_TABLES) <= set(TERMS), set(ELEMENT_TABLES) - set(TERMS)
+
+
+def test_the_shipped_examples_together_have_every_element(every_element):
+    """The scene of every element (tests/conftest.py, composed from the shipped examples) that the generic
+    tests use has every element table of the library: a new effect ships an example scene."""
+    assert {key.split(".")[0] for key, _ in every_element().tables()} == set(ELEMENT_TABLES)
+    assert len(every_element().absorbers) > 1
 
 
 def test_a_table_without_a_term_is_an_error():
@@ -325,23 +247,13 @@ def test_an_absorber_whose_gap_never_closes_changes_nothing():
     assert len(b.impacts) == len(a.impacts) and all(i.contact == "busy_contact" for i in b.impacts)
 
 
-def test_an_unreachable_stop_changes_nothing():
-    plain = model_ii(1000.0, 0.0)
-    far = plain.with_changes(recoil_stop=RecoilStop(position=1.0, stiffness=1e9, exponent=1.5, damping_factor=0.5),
-                             battery_stop=BatteryStop(position=-1.0, law="hertz", stiffness=1e9, exponent=1.5))
-    a, b = solve_reference(plain, 3.0), solve_reference(far, 3.0)
-    for name in ("max_barrel_displacement", "peak_contact_force", "max_absorber_velocity", "peak_support_force"):
-        _close(getattr(b, name), getattr(a, name), 1e-9)
-    assert all(m.episodes == [] and m.peak_force == 0.0 for m in b.stop_metrics.values())
-
-
 @pytest.mark.parametrize("law", ["lankarani-nikravesh", "flores", "gonthier", "exact-restitution"])
-def test_first_impact_of_a_restitution_law_is_hunt_crossley_with_chi_over_v0(law):
+def test_first_impact_of_a_restitution_law_is_hunt_crossley_with_chi_over_v0(law, design):
     """At gap 0 the first episode starts at t = 0 with v- = v0, so the law is Hunt-Crossley with
     lambda = chi / v0 until that episode ends."""
     scene = model_ii(500.0, 0.0)
     v0 = scene.initial_velocity
-    chi = _chi(law, 0.6)
+    chi = design.chi(law, 0.6)
     ours = solve_reference(scene.with_changes(contact=Contact(gap=0.0, law=law, stiffness=2.1e8, exponent=1.3,
                                                               restitution=0.6)), 0.2)
     hc = solve_reference(scene.with_changes(contact=Contact(gap=0.0, stiffness=2.1e8, exponent=1.3,
