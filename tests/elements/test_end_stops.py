@@ -1,8 +1,8 @@
 """End stops (mbs_models.elements.end_stops, validation/reference/terms/end_stops.py): the barrel against the
 ground, any contact law.  Everything particular to the stops: the engine's items, outputs and errors, the
-reference's equations, names and hard cases.  The generic tests (tests/validation/reference/, ...) run on
-scenes of every element that include the stops (the ``every_element`` fixture of tests/conftest.py; checked
-below)."""
+reference's equations, names, outputs and hard cases.  The generic tests (tests/validation/reference/, ...)
+run on scenes of every element that include the stops (the ``every_element`` fixture of tests/conftest.py;
+checked below)."""
 
 from __future__ import annotations
 
@@ -171,6 +171,47 @@ def test_the_reference_names_the_stops_after_their_tables(every_element):
     assert [c.name for c in model.dissipating] == ["recoil_damper", "front_damper", "front_contact", "rear_damper",
                                                    "rear_contact", "recoil_stop", "battery_stop"]
     assert model.n_states == 2 * 3 + 7
+
+
+#: model (ii), m = 100 kg, with a hard recoil stop and a Kelvin-Voigt buffer 20 mm behind battery
+II_STOPS = model_ii(100.0, 0.0).with_changes(
+    recoil_stop=RecoilStop(position=0.12, law="hunt-crossley", stiffness=1e9, exponent=1.5, damping_factor=0.5),
+    battery_stop=BatteryStop(position=-0.02, law="kelvin-voigt", stiffness=5e7, damping=2e5))
+
+
+@pytest.fixture(scope="module")
+def ii_stops_reference():
+    return solve_reference(II_STOPS, 2.0)
+
+
+def test_the_stops_push_the_mount_in_opposite_directions_in_the_reference(ii_stops_reference):
+    """Support force of the reference: the recoil stop (ground -> barrel) adds +F, the battery stop (barrel ->
+    ground) -F, to the paper's S = k x_M + c(v_M) v_M + k_r x_m + c_r v_m."""
+    r = ii_stops_reference
+    t = np.linspace(0.0, 2.0, 4001)
+    x, v, x_m, v_m = r.position("barrel", t), r.velocity("barrel", t), r.position("absorber", t), r.velocity("absorber", t)
+    c = np.where(v > 0, 6239.0, 14050.0)
+    expected = 27500.0 * x + c * v + 13500.0 * x_m + 3675.0 * v_m \
+        + r.connector_force("recoil_stop", t) - r.connector_force("battery_stop", t)
+    np.testing.assert_allclose(r.support_force(t), expected, rtol=1e-12, atol=1e-9 * np.max(np.abs(expected)))
+    assert np.any(r.connector_force("recoil_stop", t) > 0) and np.any(r.connector_force("battery_stop", t) > 0)
+
+
+def test_the_reference_reports_each_stop(ii_stops_reference):
+    """Per-stop metrics, energies and the metrics dictionary of the reference, keyed by the stops' names."""
+    r = ii_stops_reference
+    stops = {"recoil_stop", "battery_stop"}
+    assert r.connectors[-2:] == ("recoil_stop", "battery_stop")
+    assert set(r.contacts) == {"contact"} | stops and set(r.stop_metrics) == stops
+    assert stops <= set(r.dissipated_energy) and stops <= set(r.stored_energy(0.1))
+    for name, stop in r.stop_metrics.items():
+        assert stop.name == name and stop.impacts and stop.impacts == r.contacts[name].impacts
+        assert all(i.contact == name for i in stop.impacts)
+        assert stop.dissipated_energy == r.dissipated_energy[name] > 0
+        assert stop.peak_force == max(e.peak_force for e in stop.episodes)
+    assert {i.contact for i in r.impacts} == {"contact"}  # the stops' impacts are not the absorber's
+    m = r.metrics()
+    assert set(m["stops"]) == stops and m["stops"]["recoil_stop"]["dissipated_energy"] > 0
 
 
 def test_an_unreachable_stop_changes_nothing():

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from mbs_models.scene import Contact, Conventions, RecoilStop, load_scene, model_i, model_ii, simplified_model
+from mbs_models.scene import Contact, Conventions, load_scene, model_i, model_ii, simplified_model
 from validation.reference import finality
 from validation.reference import solve_reference
 from validation.reference.assembly import build_model
@@ -35,22 +35,30 @@ FAST = {
     "ii-compression_only": model_ii(1000.0, 0.0, Conventions(compression_only=True)),
 }
 
-#: two absorbers (front: ground, hunt-crossley, gap 0; rear: barrel, lankarani-nikravesh, gap 10 mm), both stops
-WITH_STOPS = load_scene(Path(__file__).parent / "data" / "two_absorbers_stops.toml")
-STOPS = dict(recoil_stop=WITH_STOPS.recoil_stop, battery_stop=WITH_STOPS.battery_stop)
-#: the effects of version 2: several absorbers, stops, every law
+#: two absorbers (front: ground, hunt-crossley, gap 0; rear: barrel, lankarani-nikravesh, gap 10 mm)
+TWO = load_scene(Path(__file__).parent / "data" / "two_absorbers.toml")
+II_EXACT = model_ii(500.0, 0.0).with_changes(contact=Contact(gap=0.0, law="exact-restitution", stiffness=2.1e8,
+                                                             exponent=1.3, restitution=0.3))
+#: the effects of version 2: several absorbers, every element, every law
 NEW = {
-    "two-absorbers": WITH_STOPS.with_changes(recoil_stop=None, battery_stop=None),
-    "ii-stops": model_ii(100.0, 0.0).with_changes(**STOPS),
-    "two-absorbers-stops": WITH_STOPS,
+    "two-absorbers": TWO,
     "ii-gonthier": model_ii(1000.0, 0.04).with_changes(contact=Contact(gap=0.04, law="gonthier", stiffness=2.1e8,
                                                                        exponent=1.3, restitution=0.4)),
     "i-kelvin-voigt": model_i(500.0, 0.0).with_changes(contact=Contact(gap=0.0, law="kelvin-voigt", stiffness=2e7,
                                                                        damping=2e4)),
-    "ii-exact-hertz-stop": model_ii(500.0, 0.0).with_changes(
-        contact=Contact(gap=0.0, law="exact-restitution", stiffness=2.1e8, exponent=1.3, restitution=0.3),
-        recoil_stop=RecoilStop(position=0.1, law="hertz", stiffness=1e9, exponent=1.5)),
 }
+#: (base, law): the base with every other element (tests/conftest.py's every_element), their contacts of that law
+EVERY = {
+    "ii-every-element": (model_ii(100.0, 0.0), {}),
+    "two-absorbers-every-element": (TWO, {}),
+    "ii-exact-every-element-hertz": (II_EXACT, dict(law="hertz", stiffness=1e9, exponent=1.5)),
+}
+
+
+@pytest.fixture(scope="module")
+def new_scenes(every_element) -> dict:
+    """The scenes of NEW and EVERY by key."""
+    return {**NEW, **{key: every_element(base, **law) for key, (base, law) in EVERY.items()}}
 SLOW = {
     **{f"{name}-m{mass:g}-gap{gap * 1e3:g}mm": factory(mass, gap)
        for name, factory in (("i", model_i), ("ii", model_ii)) for mass in (100.0, 500.0, 1000.0)
@@ -132,15 +140,16 @@ def test_early_stopped_reference_gives_the_full_runs_metrics(key, requested):
 @pytest.mark.parametrize("requested", [ALL, pytest.param(("max_barrel_displacement",), marks=pytest.mark.slow),
                                        pytest.param(("peak_support_force",), marks=pytest.mark.slow)],
                          ids=["all", "x", "S"])
-@pytest.mark.parametrize("key", list(NEW))
-def test_early_stop_with_several_absorbers_stops_and_every_law(key, requested):
-    early = _check(NEW[key], requested)
+@pytest.mark.parametrize("key", [*NEW, *EVERY])
+def test_early_stop_with_several_absorbers_every_element_and_every_law(key, requested, new_scenes):
+    early = _check(new_scenes[key], requested)
     assert early.stop_reason == "metrics_final", (key, requested)
 
 
-@pytest.mark.parametrize("key", ["two-absorbers-stops", "ii-gonthier", "i-kelvin-voigt", "ii-exact-hertz-stop"])
-def test_the_bounds_bound_the_future_with_several_absorbers_stops_and_every_law(key):
-    assert_bounds_hold(_full(NEW[key]), END)
+@pytest.mark.parametrize("key", ["two-absorbers-every-element", "ii-gonthier", "i-kelvin-voigt",
+                                 "ii-exact-every-element-hertz"])
+def test_the_bounds_bound_the_future_with_several_absorbers_every_element_and_every_law(key, new_scenes):
+    assert_bounds_hold(_full(new_scenes[key]), END)
 
 
 @pytest.mark.slow
@@ -207,15 +216,19 @@ def test_the_bounds_bound_the_future_of_the_dense_solution(key):
     assert_bounds_hold(_full(FAST[key]), END)
 
 
-@pytest.mark.parametrize("scene", [model_i(100.0, 0.0), model_ii(500.0, 0.04),
-                                   model_ii(1000.0, 0.02, Conventions(literal_gap_sign=True)),
-                                   model_i(1000.0, 0.08).with_changes(**{"contact.exponent": 1.0}),
-                                   simplified_model(), WITH_STOPS],
-                         ids=["i", "ii", "ii-literal-gap", "i-linear", "simplified", "two-absorbers-stops"])
-def test_the_two_independent_implementations_agree(scene):
+AGREE = {"i": model_i(100.0, 0.0), "ii": model_ii(500.0, 0.04),
+         "ii-literal-gap": model_ii(1000.0, 0.02, Conventions(literal_gap_sign=True)),
+         "i-linear": model_i(1000.0, 0.08).with_changes(**{"contact.exponent": 1.0}),
+         "simplified": simplified_model()}
+
+
+@pytest.mark.parametrize("key", [*AGREE, "two-absorbers-every-element"])
+def test_the_two_independent_implementations_agree(key, new_scenes):
     """The engine's bounds (mbs_models.engine.final_metrics) and the reference's, written separately,
     give the same numbers on random states."""
     from mbs_models.engine.final_metrics import EnergyBounds
+
+    scene = AGREE.get(key) or new_scenes[key]
 
     engine = EnergyBounds(scene)
     model = build_model(scene)
