@@ -9,7 +9,7 @@ here names an effect: bodies, connectors, contacts and the roles (absorbers, sto
 
 Names (DESIGN.md): bodies ``barrel`` and the absorbers' names; connectors ``recoil_spring``,
 ``recoil_damper``, ``absorber_damper`` and ``contact`` (one absorber) or ``<name>_damper`` and
-``<name>_contact`` (several), ``recoil_stop``, ``battery_stop``.
+``<name>_contact`` (several), and each end stop's connector, named like its table.
 """
 
 from __future__ import annotations

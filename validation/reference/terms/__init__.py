@@ -10,19 +10,9 @@ bounds of the early stop (:mod:`validation.reference.model`).  Adding an effect 
 adding one module here.
 
 Modules without ``TABLES`` are building blocks of the terms (:mod:`.contact_laws`, :mod:`.spring_damper`).
-
-========================  ==========================================================================
-module                    effect (tables)
-========================  ==========================================================================
-:mod:`.barrel`            the recoiling barrel, its initial velocity ``[barrel]``
-:mod:`.firing`            the shot's momentum: v0 ``[firing]``
-:mod:`.recoil_spring`     linear spring ground -> barrel ``[recoil_spring]``
-:mod:`.recoil_damper`     asymmetric damper ground -> barrel ``[recoil_damper]``
-:mod:`.absorber`          absorbers: body, actuator, contact with wall A ``[[absorber]]``
-:mod:`.end_stops`         the barrel against the ground ``[recoil_stop]``, ``[battery_stop]``
-:mod:`.contact_laws`      (building block) the contact-law family of every contact
-:mod:`.spring_damper`     (building block) the linear spring-damper ``F = k d + c d'``
-========================  ==========================================================================
+The terms are found by the table names they declare (:data:`TERMS`, below), never listed here: the README
+lists the effects and their tables, and ``tests/validation/reference/test_terms.py`` checks that every scene
+table has a term.
 """
 
 from __future__ import annotations
