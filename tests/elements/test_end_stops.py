@@ -1,8 +1,8 @@
 """End stops (mbs_models.elements.end_stops, validation/reference/terms/end_stops.py): the barrel against the
 ground, any contact law.  Everything particular to the stops: the engine's items, outputs and errors, the
-reference's equations, names, outputs and hard cases.  The generic tests (tests/validation/reference/, ...)
-run on scenes of every element that include the stops (the ``every_element`` fixture of tests/conftest.py;
-checked below)."""
+reference's equations, names, outputs and hard cases, and the engine against the reference with the README's
+guarantee at every preset.  The generic tests (tests/validation/reference/, ...) run on scenes of every element
+that include the stops (the ``every_element`` fixture of tests/conftest.py; checked below)."""
 
 from __future__ import annotations
 
@@ -17,6 +17,8 @@ from mbs_models.engine.assembly import assemble
 from mbs_models.scenes import scene_path
 from validation.reference import solve_reference
 from validation.reference.assembly import build_model
+from validation.studies.guarantee import (TOLERANCES, errors_against_reference, physical_violations, reference_for,
+                                           violations)
 
 LAW_FIELDS = {"hunt-crossley": dict(stiffness=1e9, exponent=1.5, damping_factor=0.5),
               "hertz": dict(stiffness=1e9, exponent=1.5), "kelvin-voigt": dict(stiffness=5e7, damping=2e5)}
@@ -301,3 +303,40 @@ def test_reference_stops_hit_at_ten_times_the_firing_velocity(law, assert_sound)
     x = r.barrel_position(t)
     np.testing.assert_array_equal(r.connector_force("recoil_stop", t)[x < 0.15 - 1e-12], 0.0)
     np.testing.assert_array_equal(r.connector_force("battery_stop", t)[x > -0.05 + 1e-12], 0.0)
+
+
+# ------------------------------------------------------------------ the engine against the reference
+#: name -> (scene, end time in s): the shipped example, stops of every law, stops hit at ten times the muzzle
+#: velocity (each case hits both stops)
+ENGINE_CASES = {
+    "end_stops": (load_scene(scene_path("end_stops")), 3.0),
+    **{f"law-{law}": (with_stops(model_ii(1000.0, 0.0), law), 3.0) for law in sorted(CONTACT_LAWS)},
+    **{f"10x-{law}": (with_stops(simplified_model(), law, 0.1).with_changes(**{"firing.muzzle_velocity": 5640.0}),
+                      2.0) for law in ("hunt-crossley", "kelvin-voigt", "exact-restitution")},
+}
+
+
+def check_against_reference(name: str, accuracy: str) -> dict:
+    """The README's guarantee for one case: a physical result, every error within the preset's TOLERANCES."""
+    scene, end = ENGINE_CASES[name]
+    result = simulate(scene, end, accuracy)
+    problems = physical_violations(result, TOLERANCES[accuracy]["energy"])
+    assert not problems, problems
+    ref = reference_for(scene, end, (), accuracy)
+    assert all(result.contacts[stop].impacts for stop in ("recoil_stop", "battery_stop"))  # both stops are hit
+    errors = errors_against_reference(result, ref, TOLERANCES[accuracy]["time"])
+    problems = violations(errors, accuracy)
+    assert not problems, (problems, errors, result.impacts, ref.impacts)
+    return errors
+
+
+@pytest.mark.parametrize("name", list(ENGINE_CASES))
+def test_engine_against_reference_standard(name):
+    check_against_reference(name, "standard")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("accuracy", list(TOLERANCES))
+@pytest.mark.parametrize("name", list(ENGINE_CASES))
+def test_engine_against_reference_every_preset(name, accuracy):
+    check_against_reference(name, accuracy)
