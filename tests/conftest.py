@@ -175,6 +175,27 @@ def changed():
     return apply
 
 
+@pytest.fixture
+def agrees_with_reference():
+    """``check(scene, end_time, accuracy)``: the engine's result meets the README's guarantee against the
+    independent reference (:mod:`validation.studies.guarantee`); returns the errors."""
+    from mbs_models import simulate
+    from validation.studies.guarantee import (TOLERANCES, errors_against_reference, physical_violations, reference_for,
+                                              violations)
+
+    def check(scene, end_time: float, accuracy: str) -> dict:
+        result = simulate(scene, end_time, accuracy)
+        problems = physical_violations(result, TOLERANCES[accuracy]["energy"])
+        assert not problems, problems
+        errors = errors_against_reference(result, reference_for(scene, end_time, (), accuracy),
+                                          TOLERANCES[accuracy]["time"])
+        problems = violations(errors, accuracy)
+        assert not problems, (problems, errors)
+        return errors
+
+    return check
+
+
 # ------------------------------------------------------------------ a scene of every element, composed generically
 def _shipped_scenes() -> list:
     from mbs_models import load_scene

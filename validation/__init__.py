@@ -9,12 +9,16 @@
 Importing this package loads neither Exudyn nor the engine.
 """
 
-from .reference import (METHODS, ReferenceImpact, ReferenceResult, ReferenceSegment, ReferenceSolveError,
-                        hunt_crossley_restitution, simplified_max_displacement, solve_reference)
+from .reference import (METHODS, AbsorberMetrics, ContactMetrics, ReferenceImpact, ReferenceModelError, ReferenceResult,
+                        ReferenceSegment, ReferenceSolveError, StopMetrics, achieved_restitution,
+                        exact_restitution_factor, hunt_crossley_restitution, kelvin_voigt_restitution,
+                        restitution_factor, simplified_max_displacement, solve_reference)
 from .studies.paper import PublishedValue, QualitativeClaim, published_values, qualitative_claims, table2
 
 __all__ = [
     "solve_reference", "ReferenceResult", "ReferenceImpact", "ReferenceSegment", "ReferenceSolveError",
-    "METHODS", "simplified_max_displacement", "hunt_crossley_restitution",
+    "ReferenceModelError", "ContactMetrics", "StopMetrics", "AbsorberMetrics", "METHODS",
+    "simplified_max_displacement", "hunt_crossley_restitution", "restitution_factor", "exact_restitution_factor",
+    "achieved_restitution", "kelvin_voigt_restitution",
     "PublishedValue", "QualitativeClaim", "published_values", "qualitative_claims", "table2",
 ]

@@ -33,16 +33,10 @@ from .table import Rule, Table
 
 
 @dataclass(frozen=True, kw_only=True)
-class RecoilStop(LawFields, Table):
-    """The stop at the end of the recoil stroke: a contact while ``x_M > position``.
-
-    Attributes
-    ----------
-    position: m (> 0), where the barrel meets the stop.
-    law: the contact law (default ``hunt-crossley``) and its fields: ``stiffness``, ``exponent``,
-        ``damping_factor``, ``restitution``, ``damping``, ``minimum_impact_velocity`` as the law needs
-        (see :mod:`mbs_models.elements.contact_laws`).
-    """
+class _Stop(LawFields, Table):
+    """The fields of a stop: its ``position`` (m) and a contact law with the law's fields: ``stiffness``,
+    ``exponent``, ``damping_factor``, ``restitution``, ``damping``, ``minimum_impact_velocity`` as the law
+    needs (see :mod:`mbs_models.elements.contact_laws`; default law ``hunt-crossley``)."""
 
     position: float
     law: str = "hunt-crossley"
@@ -52,43 +46,33 @@ class RecoilStop(LawFields, Table):
     restitution: float | None = None
     damping: float | None = None
     minimum_impact_velocity: float | None = None
-    TABLE: ClassVar[str] = "recoil_stop"
-    ORDER: ClassVar[int] = 60
     SINCE_VERSION: ClassVar[int] = 2
-    RULES: ClassVar = {"position": Rule(0.0, strict=True, unit="m"), **LAW_RULES}
 
     def bodies(self, scene, name: str) -> list:
         return []
+
+
+@dataclass(frozen=True, kw_only=True)
+class RecoilStop(_Stop):
+    """The stop at the end of the recoil stroke: a contact ground -> barrel while ``x_M > position``
+    (position in m, > 0); fields as :class:`_Stop`."""
+
+    TABLE: ClassVar[str] = "recoil_stop"
+    ORDER: ClassVar[int] = 60
+    RULES: ClassVar = {"position": Rule(0.0, strict=True, unit="m"), **LAW_RULES}
 
     def connectors(self, scene, name: str) -> list[Connector]:
         return [ContactConnector(name, name, GROUND, BARREL, self, self.position)]
 
 
 @dataclass(frozen=True, kw_only=True)
-class BatteryStop(LawFields, Table):
-    """The counter-recoil buffer at battery: a contact while ``x_M < position``.
+class BatteryStop(_Stop):
+    """The counter-recoil buffer at battery: a contact barrel -> ground while ``x_M < position``
+    (position in m, <= 0; 0 = the barrel touches it at the start); fields as :class:`_Stop`."""
 
-    Attributes
-    ----------
-    position: m (<= 0; 0 = the barrel touches it at the start).
-    law: the contact law and its fields, as :class:`RecoilStop`.
-    """
-
-    position: float
-    law: str = "hunt-crossley"
-    stiffness: float
-    exponent: float | None = None
-    damping_factor: float | None = None
-    restitution: float | None = None
-    damping: float | None = None
-    minimum_impact_velocity: float | None = None
     TABLE: ClassVar[str] = "battery_stop"
     ORDER: ClassVar[int] = 61
-    SINCE_VERSION: ClassVar[int] = 2
     RULES: ClassVar = {"position": Rule(maximum=0.0, unit="m"), **LAW_RULES}
-
-    def bodies(self, scene, name: str) -> list:
-        return []
 
     def connectors(self, scene, name: str) -> list[Connector]:
         return [ContactConnector(name, name, BARREL, GROUND, self, -self.position)]

@@ -102,3 +102,25 @@ def test_plot_into_unwritable_place_is_bad_input(tmp_path, capsys):
     blocker.write_text("x")
     assert main(["run", "model_i", "--end-time", "1", "--plot", str(blocker / "run.png")]) == 2
     assert "--plot" in capsys.readouterr().err
+
+
+def test_run_json_of_a_version_2_scene_has_the_new_keys(capsys):
+    """Version-1 keys keep their meaning; peak_support_force, absorbers, stops and energy are added."""
+    assert main(["run", "end_stops", "--end-time", "3", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    for key in ("max_barrel_displacement", "time_of_max_barrel_displacement", "peak_contact_force",
+                "max_absorber_velocity", "time_of_max_absorber_velocity", "impacts", "wall_time",
+                "peak_support_force", "time_of_peak_support_force", "absorbers", "stops", "energy"):
+        assert key in data, key
+    assert data["peak_support_force"] > 1e5  # the recoil stop's impact reaches the mount
+    assert [s["name"] for s in data["stops"]] == ["recoil_stop", "battery_stop"]
+    assert data["absorbers"][0]["peak_contact_force"] == data["peak_contact_force"]
+    energy = sum(sum(parts.values()) for parts in data["energy"].values())
+    assert energy == pytest.approx(0.5 * 5600.0 * data["initial_velocity"] ** 2, rel=1e-5)
+
+
+def test_run_plot_of_several_absorbers(tmp_path, capsys):
+    path = tmp_path / "run.png"
+    assert main(["run", "two_absorbers", "--end-time", "1", "--plot", str(path)]) == 0
+    assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "peak support force" in capsys.readouterr().out

@@ -115,6 +115,25 @@ def test_dotted_keys_address_absorbers():
     assert one.with_changes(**{"absorber.0.contact.gap": 0.01}) == one.with_changes(**{"contact.gap": 0.01})
 
 
+REFERENCE_SCENES = {
+    "two-on-the-ground": lambda: load_scene(scene_path("two_absorbers")),
+    "ground-and-barrel": lambda: load_scene(scene_path("two_absorbers")).with_changes(**{"absorber.1.mount": "barrel"}),
+    "two-halves-on-the-barrel": lambda: halves(model_i(1000.0, 0.02), "barrel"),
+}
+
+
+@pytest.mark.parametrize("name", list(REFERENCE_SCENES))
+def test_several_absorbers_agree_with_the_reference(agrees_with_reference, name):
+    agrees_with_reference(REFERENCE_SCENES[name](), 3.0, "standard")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("accuracy", ["draft", "standard", "reference"])
+@pytest.mark.parametrize("name", list(REFERENCE_SCENES))
+def test_several_absorbers_agree_with_the_reference_at_every_preset(agrees_with_reference, name, accuracy):
+    agrees_with_reference(REFERENCE_SCENES[name](), 10.0, accuracy)
+
+
 BAD_ABSORBERS = [
     ("missing-mass", "absorber.0.mass", "<delete>", "absorber.0.mass", "missing"),
     ("zero-mass", "absorber.1.mass", 0.0, "absorber.1.mass", "> 0 kg"),

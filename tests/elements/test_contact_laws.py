@@ -15,7 +15,8 @@ import numpy as np
 import pytest
 
 from mbs_models import (Absorber, Barrel, Contact, Conventions, RecoilDamper, RecoilSpring, Scene, SolverSettings,
-                        model_ii, simulate)
+                        load_scene, model_i, model_ii, simulate)
+from mbs_models.scenes import list_scenes, scene_path
 from mbs_models.elements.contact_laws import (CONTACT_LAWS, exact_restitution_factor, law_force, restitution_factor)
 from mbs_models.elements.ops import NUMPY_OPS, PYTHON_OPS
 from validation.reference.closed_form import hunt_crossley_restitution
@@ -214,6 +215,38 @@ def test_a_resting_contact_with_onset_velocity_near_zero_stays_finite(law):
     assert min(onsets) < 1e-9 and sum(v < 1e-3 for v in onsets) >= 5, onsets
     assert np.all(np.isfinite(result.contact_force)) and np.all(result.contact_force >= 0.0)
     assert np.max(np.abs(result.energy_error())) < 5e-6 * result.kinetic_energy_history[0]
+
+
+# ------------------------------------------------------------------------------------------ engine = reference
+LAW_SCENES = sorted(n for n in list_scenes() if n.startswith("contact_"))
+HARD_LAW_SCENES = {
+    "i-flores-e0.05-gap20mm": model_i(1000.0, 0.02).with_changes(
+        contact=Contact(gap=0.02, stiffness=2.1e8, exponent=1.3, law="flores", restitution=0.05)),
+    "i-exact-e0.99": model_i(1000.0, 0.0).with_changes(contact=restitution_law("exact-restitution", 0.99)),
+    "ii-gonthier-e0.05-m100": model_ii(100.0, 0.0).with_changes(contact=restitution_law("gonthier", 0.05)),
+    "ii-lankarani-e0.99-10x": model_ii(1000.0, 0.0).with_changes(contact=restitution_law("lankarani-nikravesh", 0.99),
+                                                                  **{"firing.muzzle_velocity": 5640.0}),
+}
+
+
+@pytest.mark.parametrize("name", LAW_SCENES)
+def test_every_law_agrees_with_the_reference(agrees_with_reference, name):
+    """Model (ii), m = 1000 kg, gap 0, with each law (the shipped examples): the README's guarantee."""
+    agrees_with_reference(load_scene(scene_path(name)), 3.0, "standard")
+
+
+@pytest.mark.parametrize("name", list(HARD_LAW_SCENES))
+def test_hard_restitution_cases_agree_with_the_reference(agrees_with_reference, name):
+    """Restitution 0.05 and 0.99, a light absorber, ten times the firing velocity."""
+    agrees_with_reference(HARD_LAW_SCENES[name], 3.0, "standard")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("accuracy", ["draft", "standard", "reference"])
+@pytest.mark.parametrize("name", LAW_SCENES + list(HARD_LAW_SCENES))
+def test_every_law_agrees_with_the_reference_at_every_preset(agrees_with_reference, name, accuracy):
+    scene = HARD_LAW_SCENES[name] if name in HARD_LAW_SCENES else load_scene(scene_path(name))
+    agrees_with_reference(scene, 10.0, accuracy)
 
 
 # ------------------------------------------------------------------------------------------ bad input

@@ -102,7 +102,8 @@ def errors_against_reference(result, ref, merge_gap: float = 0.0) -> dict:
     balance), ``time`` (impact start/end, s), ``peaks`` (impact peaks), and the integer
     ``impact_mismatch`` (impacts present on one side only, outside the ambiguous band around the
     threshold, summed over the contacts).  Episodes separated by less than ``merge_gap`` s count as one
-    (:func:`merge_close`).  Peaks are compared where the reference covers the whole run.
+    (:func:`merge_close`).  Where the reference covers only the start of the run, a peak is the engine's
+    refined one if it falls in that window, else the largest engine sample in it.
     """
     scene = result.scene
     window = ref.end_time
@@ -110,13 +111,21 @@ def errors_against_reference(result, ref, merge_gap: float = 0.0) -> dict:
     energy = ref.initial_energy
     inside = result.time <= window + 1e-12
     out: dict = {}
-    x_engine = result.max_barrel_displacement if full else float(np.max(result.barrel_position[inside]))
+
+    def within(value, time_of_value, samples):
+        """The engine's refined peak if it lies in the reference's window (then it is that window's peak
+        too), else the largest sample in the window."""
+        if full or (time_of_value is not None and time_of_value <= window):
+            return value
+        return float(np.max(samples[inside]))
+
+    x_engine = within(result.max_barrel_displacement, result.time_of_max_barrel_displacement, result.barrel_position)
     out["x"] = abs(x_engine - ref.max_barrel_displacement) / abs(ref.max_barrel_displacement)
     out["energy"] = float(np.max(np.abs(result.energy_error()))) / energy
     diss = {k: _interpolate(result, h, window) for k, h in result.dissipated_energy_history.items()}
     out["dissipated"] = max((abs(diss.get(k, 0.0) - (v or 0.0)) / energy for k, v in ref.dissipated_energy.items()),
                             default=0.0)
-    s_engine = result.peak_support_force if full else float(np.max(np.abs(result.support_force[inside])))
+    s_engine = within(result.peak_support_force, result.time_of_peak_support_force, np.abs(result.support_force))
     out["S"] = abs(s_engine - ref.peak_support_force) / max(ref.peak_support_force, 1.0)
     out["F"] = out["v"] = out["time"] = out["peaks"] = 0.0
     out["impact_mismatch"] = 0
@@ -128,8 +137,8 @@ def errors_against_reference(result, ref, merge_gap: float = 0.0) -> dict:
         out["v"] = max(out["v"], abs(v_engine - v_ref) / max(abs(v_ref), 1e-3 * v0))
     for name, contact in result.contacts.items():
         theirs = ref.contacts[name]
-        if full:
-            out["F"] = max(out["F"], abs(contact.peak_force - theirs.peak_force) / max(theirs.peak_force, 1.0))
+        peak = within(contact.peak_force, contact.time_of_peak_force, contact.force)
+        out["F"] = max(out["F"], abs(peak - theirs.peak_force) / max(theirs.peak_force, 1.0))
         mismatch, time_error, peak_error = _impact_errors(contact.impacts, theirs.impacts, result.impact_threshold,
                                                           window, merge_gap)
         out["impact_mismatch"] += mismatch
