@@ -11,6 +11,7 @@ import pytest
 
 from mbs_models import model_ii, scene_to_toml
 from mbs_models.cli import main
+from mbs_models.elements.contact_laws import LawFields
 
 
 def _write_toml(path, data: dict) -> None:
@@ -104,19 +105,27 @@ def test_plot_into_unwritable_place_is_bad_input(tmp_path, capsys):
     assert "--plot" in capsys.readouterr().err
 
 
-def test_run_json_of_a_version_2_scene_has_the_new_keys(capsys):
-    """Version-1 keys keep their meaning; peak_support_force, absorbers, stops and energy are added."""
-    assert main(["run", "end_stops", "--end-time", "3", "--json"]) == 0
+def test_run_json_of_a_version_2_scene_has_the_new_keys(tmp_path, capsys, every_element):
+    """Version-1 keys keep their meaning; peak_support_force, absorbers, stops and energy are added (a scene
+    of every element: tests/conftest.py's every_element)."""
+    scene = every_element()
+    path = tmp_path / "every_element.toml"
+    path.write_text(scene_to_toml(scene))
+    assert main(["run", str(path), "--end-time", "3", "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
     for key in ("max_barrel_displacement", "time_of_max_barrel_displacement", "peak_contact_force",
                 "max_absorber_velocity", "time_of_max_absorber_velocity", "impacts", "wall_time",
                 "peak_support_force", "time_of_peak_support_force", "absorbers", "stops", "energy"):
         assert key in data, key
-    assert data["peak_support_force"] > 1e5  # the recoil stop's impact reaches the mount
-    assert [s["name"] for s in data["stops"]] == ["recoil_stop", "battery_stop"]
-    assert data["absorbers"][0]["peak_contact_force"] == data["peak_contact_force"]
+    assert [a["name"] for a in data["absorbers"]] == scene.absorber_names()
+    assert max(a["peak_contact_force"] for a in data["absorbers"]) == data["peak_contact_force"]
+    # the contacts of the other tables are the stops, named like their tables (DESIGN.md)
+    stops = [name for name, table in scene.elements() if isinstance(table, LawFields)]
+    assert stops and [s["name"] for s in data["stops"]] == stops
+    assert all(s["peak_contact_force"] > 0 and s["dissipated_energy"] > 0 for s in data["stops"])
     energy = sum(sum(parts.values()) for parts in data["energy"].values())
-    assert energy == pytest.approx(0.5 * 5600.0 * data["initial_velocity"] ** 2, rel=1e-5)
+    assert energy == pytest.approx(scene.initial_kinetic_energy, rel=1e-5)
+    assert data["initial_velocity"] == scene.initial_velocity
 
 
 def test_run_plot_of_several_absorbers(tmp_path, capsys):

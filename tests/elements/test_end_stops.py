@@ -6,12 +6,15 @@ that include the stops (the ``every_element`` fixture of tests/conftest.py; chec
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 from scipy.optimize import minimize_scalar
 
 from mbs_models import (Barrel, BatteryStop, Firing, RecoilDamper, RecoilSpring, RecoilStop, Scene, load_scene,
                         model_ii, simplified_model, simulate)
+from mbs_models.cli import main
 from mbs_models.elements.contact_laws import CONTACT_LAWS
 from mbs_models.engine.assembly import assemble
 from mbs_models.scenes import scene_path
@@ -72,6 +75,18 @@ def test_stops_hit_at_ten_times_the_firing_velocity(law):
         assert result.contacts["recoil_stop"].peak_force > 1e5
         assert np.max(np.abs(result.energy_error())) < (1e-3 if accuracy == "draft" else 5e-6) * \
             result.kinetic_energy_history[0]
+
+
+def test_recoil_run_json_reports_the_stops(capsys):
+    """``recoil run --json`` of the shipped example: both stops by name, with their peak force, impacts and
+    dissipated energy; the recoil stop's impact reaches the mount."""
+    assert main(["run", "end_stops", "--end-time", "3", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert [s["name"] for s in data["stops"]] == ["recoil_stop", "battery_stop"]
+    for stop in data["stops"]:
+        assert stop["peak_contact_force"] > 1e4 and stop["impacts"] and stop["dissipated_energy"] > 0
+    recoil = data["stops"][0]
+    assert data["peak_support_force"] > 1e5 and data["peak_support_force"] > 0.9 * recoil["peak_contact_force"]
 
 
 def test_a_scene_without_stops_adds_no_stop_item():
