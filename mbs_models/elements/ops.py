@@ -24,21 +24,28 @@ class Ops:
     """The operations of one backend.
 
     ``maximum(a, b)``, ``power(a, x)``, ``choose(condition, value_if_true, value_if_false)`` (values are
-    numbers), ``name``: ``"python"``, ``"symbolic"`` or ``"numpy"``.
+    numbers), ``select(condition, a, b)`` (values may be expressions of the backend), ``absolute(a)``,
+    ``tanh(a)``, ``log(a)``; ``name``: ``"python"``, ``"symbolic"`` or ``"numpy"``.
     """
 
     maximum: Callable[[Any, Any], Any]
     power: Callable[[Any, float], Any]
     choose: Callable[[Any, float, float], Any]
     name: str = "python"
+    select: Callable[[Any, Any, Any], Any] = None
+    absolute: Callable[[Any], Any] = None
+    tanh: Callable[[Any], Any] = None
+    log: Callable[[Any], Any] = None
 
 
 def _py_choose(condition, a, b):
     return a if condition else b
 
 
-PYTHON_OPS = Ops(maximum=max, power=math.pow, choose=_py_choose, name="python")
-NUMPY_OPS = Ops(maximum=np.maximum, power=np.power, choose=np.where, name="numpy")
+PYTHON_OPS = Ops(maximum=max, power=math.pow, choose=_py_choose, name="python", select=_py_choose, absolute=abs,
+                 tanh=math.tanh, log=math.log)
+NUMPY_OPS = Ops(maximum=np.maximum, power=np.power, choose=np.where, name="numpy", select=np.where,
+                absolute=np.abs, tanh=np.tanh, log=np.log)
 
 
 def symbolic_ops() -> Ops:
@@ -50,7 +57,31 @@ def symbolic_ops() -> Ops:
     def choose(condition, a, b):
         return esym.IfThenElse(condition, esym.Real(a), esym.Real(b))
 
-    return Ops(maximum=esym.max, power=esym.pow, choose=choose, name="symbolic")
+    def select(condition, a, b):
+        wrap = (lambda value: esym.Real(value) if isinstance(value, (int, float)) else value)
+        return esym.IfThenElse(condition, wrap(a), wrap(b))
+
+    return Ops(maximum=esym.max, power=esym.pow, choose=choose, name="symbolic", select=select,
+               absolute=esym.abs, tanh=esym.tanh, log=esym.log)
+
+
+def piecewise_linear(x, points, ops: Ops):
+    """The piecewise-linear function through ``points`` (``[(x0, y0), (x1, y1), ...]``, x increasing) at ``x``,
+    over ``ops``; constant ``y0`` before ``x0`` and ``y_last`` after the last point (use explicit end
+    points, e.g. a 0 force, where the function must vanish outside the table).
+
+    ``y = y_i + (y_{i+1} - y_i) (x - x_i) / (x_{i+1} - x_i)`` on ``[x_i, x_{i+1}]``: a chain of selections
+    (one comparison per point in the symbolic backend; ``numpy.interp`` for arrays).
+    """
+    xs = [float(p[0]) for p in points]
+    ys = [float(p[1]) for p in points]
+    if ops.name == "numpy":
+        return np.interp(x, xs, ys)
+    result = ys[-1]
+    for i in range(len(xs) - 2, -1, -1):  # from the last segment back: select(x < x_{i+1}, segment_i, rest)
+        slope = (ys[i + 1] - ys[i]) / (xs[i + 1] - xs[i])
+        result = ops.select(x < xs[i + 1], ys[i] + slope * (x - xs[i]), result)
+    return ops.select(x < xs[0], ys[0], result)
 
 
 def ops_for(backend: str) -> Ops:

@@ -1,0 +1,39 @@
+"""The backend ops: every backend evaluates the same law to the same number."""
+
+import exudyn
+import numpy as np
+import pytest
+
+from mbs_models.elements.ops import NUMPY_OPS, PYTHON_OPS, piecewise_linear, symbolic_ops
+
+PULSE = [(0.0, 0.0), (0.002, 2.0e6), (0.006, 6.0e5), (0.012, 0.0)]
+
+
+def _symbolic(function, x):
+    return function(exudyn.symbolic.Real(float(x)), symbolic_ops()).Evaluate()
+
+
+@pytest.mark.parametrize("points", [PULSE, [(0.0, 3e-4), (0.3, 1e-4), (0.5, 0.5e-4)], [(0.1, 7.0), (0.2, 7.0)]])
+def test_piecewise_linear_agrees_with_numpy_interp_on_every_backend(points):
+    xs = np.linspace(points[0][0] - 0.05, points[-1][0] + 0.05, 57)
+    expected = np.interp(xs, [p[0] for p in points], [p[1] for p in points])
+    assert np.array_equal(piecewise_linear(xs, points, NUMPY_OPS), expected)
+    python = [piecewise_linear(float(x), points, PYTHON_OPS) for x in xs]
+    symbolic = [_symbolic(lambda v, ops: piecewise_linear(v, points, ops), x) for x in xs]
+    assert np.allclose(python, expected, rtol=1e-14, atol=1e-9 * max(abs(p[1]) for p in points))
+    assert np.allclose(symbolic, expected, rtol=1e-14, atol=1e-9 * max(abs(p[1]) for p in points))
+
+
+def test_piecewise_linear_hits_the_table_points_exactly():
+    for x, y in PULSE:
+        assert piecewise_linear(x, PULSE, PYTHON_OPS) == y
+
+
+@pytest.mark.parametrize("name", ["absolute", "tanh", "log"])
+def test_unary_ops_agree(name):
+    values = [0.3, 1.7, 2.5]
+    for x in values:
+        python = getattr(PYTHON_OPS, name)(x)
+        assert getattr(NUMPY_OPS, name)(np.array([x]))[0] == pytest.approx(python, rel=1e-15)
+        assert _symbolic(lambda v, ops: getattr(ops, name)(v), x) == pytest.approx(python, rel=1e-15)
+    assert PYTHON_OPS.absolute(-2.0) == 2.0 and _symbolic(lambda v, ops: ops.absolute(v), -2.0) == 2.0
