@@ -173,3 +173,98 @@ class Connector:
         if self.damping > 0:
             bound += self.damping * rate_bound
         return bound if math.isfinite(bound) else math.inf
+
+
+class Load:
+    """An external force on one body, a function of time only: ``F(t)`` in N, positive in the recoil direction.
+
+    Gravity along an inclined cradle (a constant), the breech force of a shot (a pulse).  A load acts on
+    ``body`` alone: it is not transmitted to the mount (no support force).  Its work
+    ``W(t) = integral_0^t F v_body dt`` (J) enters the energy balance::
+
+        kinetic + stored + dissipated - work = initial energy
+
+    The base class is a constant load ``constant`` (N): Exudyn's ``LoadCoordinate`` with a fixed value, no
+    user function, and exact work ``F (x(t) - x(0))``.  Subclasses with a time law set
+    :attr:`needs_user_function`, implement :meth:`law` over the backend ops, and list their
+    :attr:`breakpoints` (times where F jumps: the solve is split there) and :attr:`windows` (intervals
+    where F varies: the solve's step is limited there) and :attr:`last_input_time` (F is 0 afterwards).
+
+    Attributes
+    ----------
+    name: unique id in the scene: the key of its work (``"gravity"``, ``"breech_force"``).
+    element: the scene element it belongs to.
+    body: the body it acts on.
+    constant: the force of a constant load (N).
+    """
+
+    needs_user_function = False
+
+    def __init__(self, name: str, element: str, body: str, *, constant: float = 0.0):
+        self.name, self.element, self.body = name, element, body
+        self.constant = float(constant)
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}({self.name!r} on {self.body})"
+
+    # ------------------------------------------------------------------ the law
+    def law(self, t, ops: Ops):
+        """The force in N at time ``t`` (s), over ``ops``."""
+        return self.constant
+
+    def force(self, t):
+        """The force (N) at times ``t`` (s): numpy backend."""
+        t = np.asarray(t, dtype=float)
+        return np.full_like(t, self.constant) if not self.needs_user_function else self.law(t, NUMPY_OPS)
+
+    @property
+    def breakpoints(self) -> tuple[float, ...]:
+        """Times (s) where F jumps (the solve is split there).  A constant load has none."""
+        return ()
+
+    @property
+    def windows(self) -> tuple[tuple[float, float], ...]:
+        """``(start, end)`` intervals (s) where F varies in time (the step is limited there).  None for a constant."""
+        return ()
+
+    @property
+    def last_input_time(self) -> float:
+        """Time (s) after which the load does no more work (0 for none; inf for a constant non-zero load)."""
+        return math.inf if self.constant != 0.0 else 0.0
+
+    # ------------------------------------------------------------------ Exudyn
+    def add_items(self, mbs, marker, user_functions: str = "symbolic"):
+        """Add the load to an Exudyn system on a coordinate marker; return its LoadIndex.
+
+        A ``LoadCoordinate``: the constant, or :meth:`law` as its load user function (``"symbolic"``,
+        recorded once and evaluated in C++, or ``"python"``).
+        """
+        from exudyn.itemInterface import LoadCoordinate
+
+        index = mbs.AddLoad(LoadCoordinate(markerNumber=marker, load=self.constant,
+                                           visualization={"show": False}))
+        if self.needs_user_function:
+            ops = ops_for(user_functions)
+            law = self.law
+
+            def user_function(mbs, t, load):
+                return law(t, ops)
+
+            if user_functions == "python":
+                self._user_function = user_function
+            else:
+                from exudyn.advancedUtilities import CreateSymbolicUserFunction
+                self._user_function = CreateSymbolicUserFunction(mbs, user_function, "loadUserFunction", index)
+            mbs.SetLoadParameter(index, "loadUserFunction", self._user_function)
+        self.index = index
+        return index
+
+    # ------------------------------------------------------------------ energy
+    def work(self, quadrature: Quadrature, position, velocity_nodes, times_nodes):
+        """Cumulative work (J) at the output samples: ``F (x - x(0))`` for a constant load (exact), else
+        ``F(t) v`` integrated; ``position`` (m) of the body at the samples, ``velocity_nodes`` (m/s) and
+        ``times_nodes`` (s) at each interval's quadrature nodes."""
+        if not self.needs_user_function:
+            position = np.asarray(position, dtype=float)
+            return self.constant * (position - position[0])
+        return quadrature(self.force(times_nodes) * velocity_nodes)

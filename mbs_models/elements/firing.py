@@ -1,48 +1,319 @@
-"""The shot that starts the motion: v0 from the conservation of momentum (Section 2.1 of the paper).
+"""The shots that drive the recoil: the momentum of each shot, or the breech-force pulse, and bursts.
 
-Table ``[firing]``: ``projectile_mass`` (kg) and ``muzzle_velocity`` (m/s); the barrel starts at
-``v0 = projectile_mass * muzzle_velocity / M`` (6.86 kg x 564 m/s / 5600 kg = 0.6909 m/s; the paper prints
-the rounded 0.7 m/s).  The scene's conventions may read it differently (``v0_includes_absorber``: the
-momentum accelerates the barrel and every absorber it carries; ``rounded_initial_velocity``).
-It adds no body and no force: its effect is the barrel's initial velocity.
+Table ``[firing]`` (Section 2.1 of the paper; DESIGN.md "Scene format, version 2")::
+
+    projectile_mass = 6.86     # kg
+    muzzle_velocity = 564.0    # m/s
+    charge_mass = 0.0          # kg of propellant (version 2; default 0)
+    gas_velocity = 1400.0      # m/s of the powder gas (needed when charge_mass > 0)
+    [firing.pulse]             # version 2: a breech force F(t) on the barrel instead of an initial velocity
+    times  = [0.0, 0.002, 0.006, 0.012]     # s, increasing, >= 0
+    forces = [0.0, 2.0e6, 6.0e5, 0.0]       # N, >= 0, piecewise linear, 0 outside the table
+    # file = "breech_force.csv"             # or two columns time,force (s, N) after a header line
+    # scale_to_momentum = true              # scale the forces so that the impulse equals the momentum
+
+Momentum of a shot (the free-recoil momentum, with the gas after-effect)::
+
+    I = projectile_mass * muzzle_velocity + charge_mass * gas_velocity          (kg m/s)
+
+(6.86 kg x 564 m/s = 3869 kg m/s in the paper, no charge).  Without a pulse, a shot is an impulse: the
+barrel starts at ``v0 = I / M`` (6.86 x 564 / 5600 = 0.6909 m/s; the paper prints the rounded 0.7 m/s;
+the scene's conventions may read it differently: ``v0_includes_absorber`` divides by M + m,
+``rounded_initial_velocity`` rounds it).  With a pulse the barrel starts at rest and the breech force
+``F(t)`` (N) acts on it: a :class:`BreechForce` load whose work enters the energy balance; its impulse
+``integral F dt`` is reported (:attr:`Pulse.impulse`).
+
+Table ``[burst]`` (version 2): ``shots`` (>= 1) fired every ``interval`` s; shot k fires at
+``t_k = k * interval``.  Without a pulse each later shot adds the same velocity jump ``v0`` to the barrel
+(an impulse, :meth:`Burst.impulses`); with a pulse the pulse repeats, shifted by ``t_k``.  A shot that
+fires while the barrel is out of battery is reported, not refused (``Result.shots``).
 """
 
 from __future__ import annotations
 
+import contextvars
+import csv
+import math
 from dataclasses import dataclass
+from pathlib import Path
 from typing import ClassVar
 
-from .table import Rule, Table
+from ..errors import SceneError
+from .barrel import BARREL
+from .connector import Load
+from .ops import Ops, piecewise_linear
+from .table import Rule, Table, check_number
+
+#: The directory that relative file names in a scene (``firing.pulse.file``) resolve against: the
+#: scene file's directory while :func:`mbs_models.load_scene` reads it, else the working directory.
+SCENE_DIRECTORY: contextvars.ContextVar[Path | None] = contextvars.ContextVar("scene_directory", default=None)
+
+
+def _number_list(key: str, values, rule: Rule) -> tuple[float, ...]:
+    if isinstance(values, (str, bytes)) or not isinstance(values, (list, tuple)):
+        raise SceneError(key, f"must be a list of numbers, got {type(values).__name__}")
+    return tuple(check_number(f"{key}.{i}", v, rule) for i, v in enumerate(values))
+
+
+def read_pulse_file(path: Path, key: str) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """(times s, forces N) from a CSV file of two columns ``time,force`` after one header line."""
+    try:
+        with open(path, newline="", encoding="utf-8") as handle:
+            rows = [row for row in csv.reader(handle) if row and any(cell.strip() for cell in row)]
+    except (OSError, UnicodeDecodeError) as exc:
+        raise SceneError(key, f"cannot read the pulse file {path}: {exc}") from None
+    if len(rows) < 3:
+        raise SceneError(key, f"{path}: needs a header line and at least two rows time,force")
+    times, forces = [], []
+    for line, row in enumerate(rows[1:], start=2):
+        if len(row) != 2:
+            raise SceneError(key, f"{path} line {line}: needs two columns time,force, got {len(row)}")
+        try:
+            times.append(float(row[0]))
+            forces.append(float(row[1]))
+        except ValueError:
+            raise SceneError(key, f"{path} line {line}: not numbers: {','.join(row)!r}") from None
+    return tuple(times), tuple(forces)
+
+
+@dataclass(frozen=True)
+class Pulse(Table):
+    """The breech force on the barrel, piecewise linear in time, 0 outside the table (version 2).
+
+    Attributes
+    ----------
+    times: s, strictly increasing, >= 0 (at least two).
+    forces: N, >= 0, one per time.
+    file: a CSV file (``time,force`` columns after a header line) instead of ``times``/``forces``;
+        relative to the scene file.
+    scale_to_momentum: scale the forces so that the impulse equals the firing momentum.
+    """
+
+    times: tuple | None = None
+    forces: tuple | None = None
+    file: str | None = None
+    scale_to_momentum: bool = False
+    TABLE: ClassVar[str] = "pulse"
+    SINCE_VERSION: ClassVar[int] = 2
+
+    def __post_init__(self):
+        key = self.TABLE
+        if not isinstance(self.scale_to_momentum, bool):
+            raise SceneError(f"{key}.scale_to_momentum", "must be true or false")
+        if self.file is not None:
+            if not isinstance(self.file, str) or not self.file:
+                raise SceneError(f"{key}.file", "must be a file name (a string)")
+            if self.times is not None or self.forces is not None:
+                raise SceneError(f"{key}.file", "give either file or times and forces, not both")
+            path = Path(self.file)
+            if not path.is_absolute():
+                path = (SCENE_DIRECTORY.get() or Path.cwd()) / path
+            times, forces = read_pulse_file(path, f"{key}.file")
+        else:
+            if self.times is None or self.forces is None:
+                missing = "times" if self.times is None else "forces"
+                raise SceneError(f"{key}.{missing}", "missing required key (or give file)")
+            times, forces = self.times, self.forces
+        times = _number_list(f"{key}.times", times, Rule(0.0, unit="s"))
+        forces = _number_list(f"{key}.forces", forces, Rule(0.0, unit="N"))
+        if len(times) < 2:
+            raise SceneError(f"{key}.times", f"needs at least two points, got {len(times)}")
+        if len(forces) != len(times):
+            raise SceneError(f"{key}.forces", f"needs one force per time: {len(times)} times, {len(forces)} forces")
+        for i in range(1, len(times)):
+            if times[i] <= times[i - 1]:
+                raise SceneError(f"{key}.times.{i}", f"must increase: {times[i]:g} s after {times[i - 1]:g} s")
+        if not any(f > 0 for f in forces):
+            raise SceneError(f"{key}.forces", "are all 0: the pulse does nothing")
+        if self.file is None:
+            object.__setattr__(self, "times", times)
+            object.__setattr__(self, "forces", forces)
+        object.__setattr__(self, "_table", (times, forces))
+
+    @property
+    def table(self) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        """(times s, forces N) as given (read from the file if one is named), before any scaling."""
+        return self._table
+
+    @property
+    def impulse(self) -> float:
+        """``integral F dt`` (N s) of the table as given (trapezoidal: exact for a piecewise-linear force)."""
+        t, f = self.table
+        return sum(0.5 * (f[i] + f[i + 1]) * (t[i + 1] - t[i]) for i in range(len(t) - 1))
+
+    @property
+    def duration(self) -> float:
+        """Last time minus first time of the table (s)."""
+        t = self.table[0]
+        return t[-1] - t[0]
+
+    def to_mapping(self):
+        out = {"file": self.file} if self.file is not None else {"times": list(self.times), "forces": list(self.forces)}
+        if self.scale_to_momentum:
+            out["scale_to_momentum"] = True
+        return out
 
 
 @dataclass(frozen=True)
 class Firing(Table):
-    """The projectile whose momentum sets the barrel moving.
+    """The shot: the projectile (and its charge) whose momentum drives the recoil, or a breech-force pulse.
 
     Attributes
     ----------
-    projectile_mass: kg (> 0), 6.86 kg in the paper.
-    muzzle_velocity: m/s (> 0), 564 m/s in the paper.
+    projectile_mass: kg (> 0), 6.86 kg in the paper; required unless a pulse is given.
+    muzzle_velocity: m/s (> 0), 564 m/s in the paper; required unless a pulse is given.
+    charge_mass: kg of propellant (>= 0, default 0): the gas after-effect adds ``charge_mass * gas_velocity``.
+    gas_velocity: m/s (> 0) of the powder gas leaving the muzzle; required when ``charge_mass > 0``.
+    pulse: a :class:`Pulse` (version 2): the breech force instead of an initial velocity.
     """
 
-    projectile_mass: float
-    muzzle_velocity: float
+    projectile_mass: float | None = None
+    muzzle_velocity: float | None = None
+    charge_mass: float = 0.0
+    gas_velocity: float | None = None
+    pulse: Pulse | None = None
     TABLE: ClassVar[str] = "firing"
     ORDER: ClassVar[int] = 5
     RULES: ClassVar = {"projectile_mass": Rule(0.0, strict=True, unit="kg"),
-                       "muzzle_velocity": Rule(0.0, strict=True, unit="m/s")}
+                       "muzzle_velocity": Rule(0.0, strict=True, unit="m/s"),
+                       "charge_mass": Rule(0.0, unit="kg"),
+                       "gas_velocity": Rule(0.0, strict=True, unit="m/s")}
+    NESTED: ClassVar = {"pulse": Pulse}
+
+    def __post_init__(self):
+        super().__post_init__()
+        needs_projectile = self.pulse is None or self.pulse.scale_to_momentum
+        for name in ("projectile_mass", "muzzle_velocity"):
+            if needs_projectile and getattr(self, name) is None:
+                why = "" if self.pulse is None else " (firing.pulse.scale_to_momentum needs the momentum)"
+                raise SceneError(f"{self.TABLE}.{name}", f"missing required key{why}")
+        if (self.projectile_mass is None) != (self.muzzle_velocity is None):
+            missing = "projectile_mass" if self.projectile_mass is None else "muzzle_velocity"
+            raise SceneError(f"{self.TABLE}.{missing}", "missing: give both projectile_mass and muzzle_velocity")
+        if self.charge_mass > 0 and self.gas_velocity is None:
+            raise SceneError(f"{self.TABLE}.gas_velocity", "missing: a charge_mass > 0 needs the gas velocity (m/s)")
+        if self.charge_mass > 0 and self.projectile_mass is None:
+            raise SceneError(f"{self.TABLE}.projectile_mass", "missing: the charge's momentum adds to the projectile's")
+
+    @classmethod
+    def required_keys(cls) -> tuple[str, ...]:
+        return ()  # checked in __post_init__: the projectile is required unless a pulse is given
 
     @property
     def momentum(self) -> float:
-        """Projectile momentum in kg m/s."""
-        return self.projectile_mass * self.muzzle_velocity
+        """Free-recoil momentum in kg m/s: ``projectile_mass * muzzle_velocity + charge_mass * gas_velocity``."""
+        if self.projectile_mass is None:
+            return self.pulse.impulse
+        momentum = self.projectile_mass * self.muzzle_velocity
+        if self.charge_mass > 0:
+            momentum += self.charge_mass * self.gas_velocity
+        return momentum
 
     def initial_velocity(self, moving_mass: float) -> float:
-        """v0 (m/s) of a recoiling mass ``moving_mass`` (kg): momentum / mass."""
+        """v0 (m/s) of a recoiling mass ``moving_mass`` (kg): momentum / mass; 0 with a pulse (at rest)."""
+        if self.pulse is not None:
+            return 0.0
         return self.momentum / moving_mass
+
+    def pulse_points(self, shot_times=(0.0,)) -> list[tuple[float, float]]:
+        """The breech force of every shot as ``(t s, F N)`` points (jumps as repeated times), scaled to the
+        momentum if asked: the table shifted by each shot time."""
+        times, forces = self.pulse.table
+        scale = self.momentum / self.pulse.impulse if self.pulse.scale_to_momentum else 1.0
+        points: list[tuple[float, float]] = []
+        for shot in shot_times:
+            if forces[0] != 0.0:
+                points.append((shot + times[0], 0.0))
+            points += [(shot + t, scale * f) for t, f in zip(times, forces)]
+            if forces[-1] != 0.0:
+                points.append((shot + times[-1], 0.0))
+        return points
 
     def bodies(self, scene, name: str) -> list:
         return []
 
     def connectors(self, scene, name: str) -> list:
         return []
+
+    def loads(self, scene, name: str) -> list[Load]:
+        """The breech force on the barrel (every shot of a burst) if a pulse is given; else none."""
+        if self.pulse is None:
+            return []
+        burst = getattr(scene, "burst", None)
+        shots = burst.shot_times if burst is not None else (0.0,)
+        return [BreechForce(name, self.pulse_points(shots), [(s + self.pulse.table[0][0], s + self.pulse.table[0][-1])
+                                                             for s in shots])]
+
+
+class BreechForce(Load):
+    """The breech force ``F(t)`` on the barrel (N): piecewise linear through ``points``, 0 outside."""
+
+    needs_user_function = True
+
+    def __init__(self, element: str, points: list[tuple[float, float]], windows: list[tuple[float, float]]):
+        super().__init__("breech_force", element, BARREL)
+        self.points = list(points)
+        self._windows = tuple(windows)
+
+    def law(self, t, ops: Ops):
+        return piecewise_linear(t, self.points, ops)
+
+    @property
+    def breakpoints(self) -> tuple[float, ...]:
+        """Start and end of every shot's pulse (the force may jump there)."""
+        return tuple(sorted({x for window in self._windows for x in window}))
+
+    @property
+    def windows(self) -> tuple[tuple[float, float], ...]:
+        return self._windows
+
+    @property
+    def last_input_time(self) -> float:
+        return self._windows[-1][1]
+
+
+@dataclass(frozen=True)
+class Burst(Table):
+    """``shots`` shots (integer >= 1) fired every ``interval`` s (> 0): shot k at ``t_k = k * interval``."""
+
+    shots: int
+    interval: float
+    TABLE: ClassVar[str] = "burst"
+    ORDER: ClassVar[int] = 6
+    SINCE_VERSION: ClassVar[int] = 2
+    RULES: ClassVar = {"interval": Rule(0.0, strict=True, unit="s")}
+
+    def __post_init__(self):
+        if isinstance(self.shots, bool) or not isinstance(self.shots, int) and not (
+                isinstance(self.shots, float) and self.shots.is_integer()):
+            raise SceneError(f"{self.TABLE}.shots", f"must be a whole number >= 1, got {self.shots!r}")
+        object.__setattr__(self, "shots", int(self.shots))
+        if not 1 <= self.shots <= 1000:
+            raise SceneError(f"{self.TABLE}.shots", f"must be in [1, 1000], got {self.shots}")
+        super().__post_init__()
+
+    @property
+    def shot_times(self) -> tuple[float, ...]:
+        """Firing times (s): ``k * interval`` for k = 0 .. shots - 1."""
+        return tuple(k * self.interval for k in range(self.shots))
+
+    def check_in_scene(self, scene, key: str) -> None:
+        firing = scene.firing
+        if firing is not None and firing.pulse is not None and firing.pulse.table[0][-1] >= self.interval:
+            raise SceneError(f"{key}.interval", f"must exceed the pulse's end ({firing.pulse.table[0][-1]:g} s): "
+                                                f"got {self.interval:g} s")
+
+    def bodies(self, scene, name: str) -> list:
+        return []
+
+    def connectors(self, scene, name: str) -> list:
+        return []
+
+    def impulses(self, scene, name: str) -> list[tuple[float, str, float]]:
+        """``(time s, body, velocity jump m/s)`` of every later shot of an impulse-model burst: the barrel
+        gains ``v0`` (:attr:`~mbs_models.scene.Scene.initial_velocity`) at ``t_k``, k >= 1.  None with a pulse
+        (the pulse repeats instead, :meth:`Firing.loads`)."""
+        firing = scene.firing
+        if firing is not None and firing.pulse is not None:
+            return []
+        return [(t, BARREL, scene.initial_velocity) for t in self.shot_times[1:]]

@@ -66,7 +66,8 @@ def symbolic_ops() -> Ops:
 
 
 def piecewise_linear(x, points, ops: Ops):
-    """The piecewise-linear function through ``points`` (``[(x0, y0), (x1, y1), ...]``, x increasing) at ``x``,
+    """The piecewise-linear function through ``points`` (``[(x0, y0), (x1, y1), ...]``, x non-decreasing; a
+    repeated x is a jump, right-continuous) at ``x``,
     over ``ops``; constant ``y0`` before ``x0`` and ``y_last`` after the last point (use explicit end
     points, e.g. a 0 force, where the function must vanish outside the table).
 
@@ -76,12 +77,26 @@ def piecewise_linear(x, points, ops: Ops):
     xs = [float(p[0]) for p in points]
     ys = [float(p[1]) for p in points]
     if ops.name == "numpy":
-        return np.interp(x, xs, ys)
+        if all(b > a for a, b in zip(xs, xs[1:])):
+            return np.interp(x, xs, ys)
+        return _numpy_piecewise_linear(np.asarray(x, dtype=float), np.array(xs), np.array(ys))
     result = ys[-1]
     for i in range(len(xs) - 2, -1, -1):  # from the last segment back: select(x < x_{i+1}, segment_i, rest)
+        if xs[i + 1] == xs[i]:
+            continue  # a jump: right-continuous, the value after it is the next segment's start
         slope = (ys[i + 1] - ys[i]) / (xs[i + 1] - xs[i])
         result = ops.select(x < xs[i + 1], ys[i] + slope * (x - xs[i]), result)
     return ops.select(x < xs[0], ys[0], result)
+
+
+def _numpy_piecewise_linear(x: np.ndarray, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
+    """:func:`piecewise_linear` for tables with jumps (repeated x): right-continuous, as the chain of selections."""
+    i = np.clip(np.searchsorted(xs, x, side="right") - 1, 0, len(xs) - 2)
+    h = xs[i + 1] - xs[i]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        inside = ys[i] + (ys[i + 1] - ys[i]) * (x - xs[i]) / h
+    value = np.where(h > 0, inside, ys[i + 1])
+    return np.where(x < xs[0], ys[0], np.where(x >= xs[-1], ys[-1], value))
 
 
 def ops_for(backend: str) -> Ops:

@@ -47,6 +47,7 @@ class Assembly:
     connectors: connector name -> ObjectIndex (``recoil_spring``, ``recoil_damper``, ``absorber_damper``,
         ``contact``, ...); absent effects are absent keys.
     user_function_connectors: names of the connectors driven by a user function.
+    loads: load name -> LoadIndex (``breech_force``, ``gravity``): external forces on a body.
     sensors: name -> SensorIndex (``barrel_position`` ... ``absorber_acceleration``, ``contact_force``).
     coordinates: body name -> index of its coordinate in the system's ODE2 coordinates.
     """
@@ -60,6 +61,7 @@ class Assembly:
     markers: dict[str, Any] = field(default_factory=dict)
     connectors: dict[str, Any] = field(default_factory=dict)
     user_function_connectors: list[str] = field(default_factory=list)
+    loads: dict[str, Any] = field(default_factory=dict)
     sensors: dict[str, Any] = field(default_factory=dict)
     coordinates: dict[str, int] = field(default_factory=dict)
 
@@ -69,8 +71,8 @@ class Assembly:
             self.system_container.Reset()
             self.system_container = None
             self.mbs = None
-            for connector in self.mechanism.connectors:
-                connector.__dict__.pop("_user_function", None)
+            for item in self.mechanism.connectors + self.mechanism.loads:
+                item.__dict__.pop("_user_function", None)
 
     def __enter__(self) -> "Assembly":
         return self
@@ -116,6 +118,8 @@ def assemble(scene: Scene, user_functions: str = "symbolic", mechanism: Mechanis
             if connector.records_force:
                 assembly.sensors[f"{connector.name}_force"] = mbs.AddSensor(
                     SensorObject(objectNumber=index, outputVariableType=_OVT.Force, storeInternal=True))
+        for load in element.loads:
+            assembly.loads[load.name] = load.add_items(mbs, assembly.markers[load.body], user_functions)
     mbs.Assemble()
     data = mbs.systemData
     assembly.coordinates = {name: data.GetNodeLTGODE2(node)[0] for name, node in assembly.nodes.items()}

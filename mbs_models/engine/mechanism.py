@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..elements.barrel import BARREL
-from ..elements.connector import GROUND, Body, Connector
+from ..elements.connector import GROUND, Body, Connector, Load
 from ..scene import Scene
 
 
@@ -25,6 +25,8 @@ class ElementParts:
     table: object
     bodies: list[Body] = field(default_factory=list)
     connectors: list[Connector] = field(default_factory=list)
+    loads: list[Load] = field(default_factory=list)
+    impulses: list[tuple[float, str, float]] = field(default_factory=list)
 
 
 class Mechanism:
@@ -36,15 +38,23 @@ class Mechanism:
     elements: :class:`ElementParts` per element, in the scene's order.
     bodies: every body (the barrel first); ``body_index[name]`` its position.
     connectors: every connector, in element order; ``connector[name]`` by name.
+    loads: every external load (:class:`~mbs_models.elements.connector.Load`), in element order.
+    impulses: ``(time s, body, velocity jump m/s)`` of every instantaneous shot after t = 0, in time order.
     """
 
     def __init__(self, scene: Scene):
         self.scene = scene
         self.elements: list[ElementParts] = []
         for name, table in scene.elements():
-            self.elements.append(ElementParts(name, table, table.bodies(scene, name), table.connectors(scene, name)))
+            loads = table.loads(scene, name) if hasattr(table, "loads") else []
+            impulses = table.impulses(scene, name) if hasattr(table, "impulses") else []
+            self.elements.append(ElementParts(name, table, table.bodies(scene, name), table.connectors(scene, name),
+                                              loads, impulses))
         self.bodies: list[Body] = [b for e in self.elements for b in e.bodies]
         self.connectors: list[Connector] = [c for e in self.elements for c in e.connectors]
+        self.loads: list[Load] = [load for e in self.elements for load in e.loads]
+        self.impulses: list[tuple[float, str, float]] = sorted(i for e in self.elements for i in e.impulses)
+        self.impulse_element = {(t, body): e.name for e in self.elements for t, body, _ in e.impulses}
         self.body_index = {body.name: i for i, body in enumerate(self.bodies)}
         self.connector = {c.name: c for c in self.connectors}
         if not self.bodies or self.bodies[0].name != BARREL:
@@ -75,6 +85,25 @@ class Mechanism:
     def capturing_contacts(self) -> list[Connector]:
         """Contacts whose law needs the onset rate v- (restitution laws)."""
         return [c for c in self.contacts if getattr(c, "capture", None) is not None]
+
+    @property
+    def last_input_time(self) -> float:
+        """Time (s) after which no load or impulse adds energy: 0 for the paper's scenes, inf under a
+        constant load (gravity); energy bounds hold only after it."""
+        last = 0.0
+        for load in self.loads:
+            last = max(last, load.last_input_time)
+        for t, _, _ in self.impulses:
+            last = max(last, t)
+        return last
+
+    @property
+    def breakpoints(self) -> list[float]:
+        """Times (s) where the solve is split: impulses and the jumps of loads, in (0, inf), sorted."""
+        times = {t for t, _, _ in self.impulses}
+        for load in self.loads:
+            times.update(load.breakpoints)
+        return sorted(t for t in times if t > 0.0)
 
     @property
     def masses(self) -> np.ndarray:

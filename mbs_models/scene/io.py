@@ -26,6 +26,7 @@ from typing import Any
 
 from ..elements import ELEMENT_TABLES
 from ..elements.contact_laws import Contact
+from ..elements.firing import SCENE_DIRECTORY
 from ..elements.table import suggestion
 from ..errors import SceneError
 from .container import Conventions, Scene
@@ -134,7 +135,11 @@ def load_scene(path: str | Path) -> Scene:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise SceneError("", f"malformed TOML in {path}: {exc}") from None
-    return scene_from_dict(data)
+    token = SCENE_DIRECTORY.set(path.resolve().parent)  # relative file names in the scene: beside it
+    try:
+        return scene_from_dict(data)
+    finally:
+        SCENE_DIRECTORY.reset(token)
 
 
 def scene_to_dict(scene: Scene) -> dict[str, Any]:
@@ -166,6 +171,8 @@ def _toml_value(value: Any) -> str:
         return str(value)
     if isinstance(value, str):
         return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_toml_value(item) for item in value) + "]"
     raise TypeError(f"cannot write {type(value).__name__} to TOML")
 
 

@@ -37,3 +37,11 @@ def test_unary_ops_agree(name):
         assert getattr(NUMPY_OPS, name)(np.array([x]))[0] == pytest.approx(python, rel=1e-15)
         assert _symbolic(lambda v, ops: getattr(ops, name)(v), x) == pytest.approx(python, rel=1e-15)
     assert PYTHON_OPS.absolute(-2.0) == 2.0 and _symbolic(lambda v, ops: ops.absolute(v), -2.0) == 2.0
+
+
+def test_piecewise_linear_with_a_jump_is_right_continuous_on_every_backend():
+    points = [(0.0, 0.0), (0.0, 5.0), (1.0, 3.0), (1.0, 0.0)]  # jumps up at 0 and down at 1
+    for x, expected in ((-0.5, 0.0), (0.0, 5.0), (0.5, 4.0), (0.999, 3.002), (1.0, 0.0), (2.0, 0.0)):
+        assert piecewise_linear(x, points, PYTHON_OPS) == pytest.approx(expected, abs=1e-12)
+        assert piecewise_linear(np.array([x]), points, NUMPY_OPS)[0] == pytest.approx(expected, abs=1e-12)
+        assert _symbolic(lambda v, ops: piecewise_linear(v, points, ops), x) == pytest.approx(expected, abs=1e-12)
