@@ -19,6 +19,10 @@ increases: its rate is minus the dissipated powers, each >= 0.  So with ``E`` no
 * **forces**: each connector bounds its force from those (``Connector.force_bound``); the support force
   ``|S|`` by the sum of the bounds of the connectors touching the ground.
 
+External inputs (loads, shots) add energy: the bounds hold only once the last of them has acted
+(:attr:`Model.last_input_time`; the solver checks from then on), and not at all under a load that never
+ends (a constant load: :attr:`Finality.enabled` is False).  The maxima are observed over the whole run.
+
 A metric is final once its observed maximum (a lower bound of the true one: values of the solution at the
 solver's step points) reaches the bound of everything later: ``max_barrel_displacement`` (x of the barrel),
 ``max_absorber_velocity`` (every absorber's v), ``peak_contact_force`` (every contact's force: absorbers
@@ -160,7 +164,8 @@ class Finality:
         self.model = model
         self.requested = check_names(requested)
         self.impact_threshold = float(impact_threshold)
-        self.enabled = not any(c.injects_energy for c in model.connectors)
+        self.enabled = (not any(c.injects_energy for c in model.connectors)
+                        and math.isfinite(model.last_input_time))
         self.energy_bounds = EnergyBounds(model)
         contacts = [c.index for c in model.contacts]
         self.items = {
@@ -190,7 +195,7 @@ class Finality:
         ts = np.asarray(sol.ts, dtype=float)
         ts = np.unique(np.concatenate(([t0], ts[(ts > t0) & (ts < t1)], [t1])))
         y = sol(ts)
-        evaluation = self.model.evaluate(mode, y)
+        evaluation = self.model.evaluate(mode, y, t=ts)
         connectors = self.model.connectors
         for item in self.observed:
             kind = item[0]
