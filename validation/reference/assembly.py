@@ -14,7 +14,7 @@ from .terms import TERMS
 
 class ModelBuilder:
     """What the terms add while a scene is read: bodies, connectors, absorbers and stops (by name), external
-    loads and velocity jumps, and the shot times (``(0.0,)`` unless a term sets them)."""
+    loads and velocity jumps, and the shot times of a burst (None unless a term sets them)."""
 
     def __init__(self, scene):
         self.scene = scene
@@ -24,7 +24,7 @@ class ModelBuilder:
         self.stops: list[str] = []
         self.loads: list[Load] = []
         self.impulses: list[Impulse] = []
-        self.shot_times: tuple[float, ...] = (0.0,)
+        self.shot_times: tuple[float, ...] | None = None
 
     def add_body(self, body: Body) -> None:
         self.bodies.append(body)
@@ -47,7 +47,7 @@ class ModelBuilder:
         self.impulses.append(impulse)
 
     def set_shot_times(self, times) -> None:
-        """The times (s) the shots fire, from 0 (the per-shot outputs and time events)."""
+        """The times (s) the shots of a burst fire, from 0 (the per-shot outputs and time events)."""
         self.shot_times = tuple(float(t) for t in times)
 
     def model(self) -> Model:

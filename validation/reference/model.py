@@ -404,12 +404,12 @@ class Model:
     """Bodies (barrel first), connectors (scene order), roles (absorbers, stops), external inputs (loads,
     impulses) and the shot times of one scene.
 
-    ``shot_times``: the times (s) the shots fire (``(0.0,)`` without a burst): the per-shot outputs of the
-    result are taken between them, and every one is a time event of the solve.
+    ``shot_times``: the times (s) the shots of a burst fire (None without a burst: one shot at t = 0): the
+    per-shot outputs of the result are taken between them, and every one is a time event of the solve.
     """
 
     def __init__(self, name: str, bodies, connectors, absorbers=(), stops=(), loads=(), impulses=(),
-                 shot_times=(0.0,)):
+                 shot_times=None):
         self.name = name
         self.bodies = tuple(bodies)
         self.connectors = tuple(connectors)
@@ -417,7 +417,7 @@ class Model:
         self.stops = tuple(stops)
         self.loads = tuple(loads)
         self.impulses = tuple(impulses)
-        self.shot_times = tuple(float(t) for t in shot_times)
+        self.shot_times = None if shot_times is None else tuple(float(t) for t in shot_times)
         if not self.bodies or self.bodies[0].name != BARREL:
             raise ReferenceModelError("the barrel must be the first body")
         names = [b.name for b in self.bodies]
@@ -478,7 +478,7 @@ class Model:
     def time_events(self) -> tuple[float, ...]:
         """Times (s, > 0, sorted) where the solve is split: the loads' breakpoints, the impulses' times and
         the shot times (a restart there, the mode classified again)."""
-        times = set(self.shot_times)
+        times = set(self.shot_times or ())
         for load in self.loads:
             times.update(load.breakpoints)
         for impulse in self.impulses:

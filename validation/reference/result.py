@@ -526,28 +526,29 @@ class ReferenceResult:
     def pulse_impulse(self) -> float | None:
         """Impulse (N s) of the first shot's breech-force pulse (``integral F dt`` of the loads that end,
         between the first and the second shot); None without a pulse."""
-        times = self.model.shot_times
+        times = self.model.shot_times or (0.0,)
         return self._transient_impulse(times[0], times[1] if len(times) > 1 else math.inf)
 
     @cached_property
-    def shots(self) -> list[dict[str, Any]]:
-        """Per shot fired in ``[0, end_time)`` (one, at t = 0, without a burst), in order, a dict:
+    def shots(self) -> list[dict[str, Any]] | None:
+        """Per shot of a burst fired in ``[0, end_time)``, in order (None without a burst), a dict:
 
-        * ``shot`` (k, from 0), ``time`` (t_k, s);
+        * ``shot`` (k + 1: 1, 2, ...), ``time`` (t_k, s);
         * ``max_barrel_displacement`` (m) and ``time_of_max_barrel_displacement`` (s): the largest x_M over
           ``[t_k, t_(k+1)]`` (the last shot: ``[t_k, end_time]``), refined on the dense output;
-        * ``position_before_next`` (m), ``velocity_before_next`` (m/s): x_M and v_M just before shot k + 1
-          fires (before its velocity jump); ``in_battery_before_next``: ``|x_M| <=``
+        * ``position_at_next_shot`` (m), ``velocity_at_next_shot`` (m/s): x_M and v_M just before shot k + 1
+          fires (before its velocity jump); ``in_battery_at_next_shot``: ``|x_M| <=``
           :data:`BATTERY_TOLERANCE` then (None for the last shot);
         * ``time_to_battery`` (s after t_k): the first time after the window's maximum at which
           ``x_M <= BATTERY_TOLERANCE`` (back within 1 mm of battery), found inside the window (None if it
-          does not return before the next shot or the end; the maximum itself if it is within 1 mm);
-        * ``pulse_impulse`` (N s): ``integral F dt`` of the breech force in the window (None without pulse).
+          does not return before the next shot or the end; the maximum itself if it is within 1 mm).
 
         After an early stop (``stop_reason == "metrics_final"``) the last shot's maximum is None unless
         ``max_barrel_displacement`` is final and lies in its window, and its ``time_to_battery`` is None
         unless the return happened before the stop.
         """
+        if self.model.shot_times is None:
+            return None
         times = [t for t in self.model.shot_times if t == 0.0 or t < self.end_time]
         stopped = self.stop_reason == STOP_METRICS_FINAL
         out = []
@@ -558,20 +559,19 @@ class ReferenceResult:
             if last and stopped:
                 proven = self._final("max_barrel_displacement") and self._barrel_max[0] >= t_k
                 t_max, x_max = (t_max, x_max) if proven else (None, None)
-            shot = {"shot": k, "time": t_k, "max_barrel_displacement": x_max,
+            shot = {"shot": k + 1, "time": t_k, "max_barrel_displacement": x_max,
                     "time_of_max_barrel_displacement": t_max,
-                    "position_before_next": None, "velocity_before_next": None, "in_battery_before_next": None}
+                    "position_at_next_shot": None, "velocity_at_next_shot": None, "in_battery_at_next_shot": None}
             if not last:
                 y = window[-1].sol(times[k + 1])
-                shot.update(position_before_next=float(y[0]), velocity_before_next=float(y[1]),
-                            in_battery_before_next=bool(abs(y[0]) <= BATTERY_TOLERANCE))
+                shot.update(position_at_next_shot=float(y[0]), velocity_at_next_shot=float(y[1]),
+                            in_battery_at_next_shot=bool(abs(y[0]) <= BATTERY_TOLERANCE))
             if t_max is None:  # the window's maximum is not known: search from the window's largest so far
                 t_from = _peak(window, _barrel_x, _barrel_v)[0]
             else:
                 t_from = t_max
             back = _first_below(window, t_from, BATTERY_TOLERANCE)
             shot["time_to_battery"] = None if back is None else back - t_k
-            shot["pulse_impulse"] = self._transient_impulse(t_k, times[k + 1] if not last else math.inf)
             out.append(shot)
         return out
 
@@ -698,8 +698,13 @@ class ReferenceResult:
         }
 
     def _input_metrics(self) -> dict[str, Any]:
-        """``work``, ``pulse_impulse`` and ``shots`` of a scene with external inputs or a burst (none else)."""
-        model = self.model
-        if not (model.loads or model.impulses or len(model.shot_times) > 1):
-            return {}
-        return {"work": self.work, "pulse_impulse": self.pulse_impulse, "shots": [dict(s) for s in self.shots]}
+        """``pulse_impulse`` (with a pulse), ``shots`` (with a burst), ``work`` (with external inputs): only
+        for scenes that have them (the version-1 keys stay as they were)."""
+        out: dict[str, Any] = {}
+        if self.pulse_impulse is not None:
+            out["pulse_impulse"] = self.pulse_impulse
+        if self.shots is not None:
+            out["shots"] = [dict(s) for s in self.shots]
+        if self.model.work_slot:
+            out["work"] = self.work
+        return out

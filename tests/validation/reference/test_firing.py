@@ -88,6 +88,7 @@ def test_a_pulse_starts_the_barrel_at_rest():
     model = build_model(scene)
     assert model.bodies[0].initial_velocity == 0.0
     assert [load.name for load in model.loads] == ["breech_force"]
+    assert model.shot_times is None  # one shot: no per-shot outputs without a burst
 
 
 # ------------------------------------------------------------------ a pulse on a free mass
@@ -99,6 +100,9 @@ def test_a_pulse_on_a_free_mass_is_the_double_integral_of_the_force():
     np.testing.assert_allclose(r.barrel_velocity(t), v, rtol=1e-11, atol=1e-16)
     assert v[-1] == pytest.approx(IMPULSE / M, rel=1e-14)  # the closed form's own consistency
     assert r.pulse_impulse == pytest.approx(IMPULSE, rel=1e-14)
+    metrics = r.metrics()
+    assert r.shots is None and "shots" not in metrics and metrics["pulse_impulse"] == r.pulse_impulse
+    assert metrics["work"] == r.work and set(r.work) == {"breech_force"}
     # the force: 0 before the pulse, jumps onto it, linear between the points, 0 after it
     np.testing.assert_allclose(r.load_force("breech_force", [0.0, 0.0009, 0.001, 0.002, 0.0085, 0.010, 0.02]),
                                [0.0, 0.0, 5.0e5, 1.25e6, 0.5 * (6.0e5 + 1.0e5), 0.0, 0.0], rtol=1e-12, atol=1e-6)
@@ -186,19 +190,20 @@ def test_a_burst_of_impulses_on_a_free_mass_is_piecewise_linear():
                                atol=1e-9)
     assert np.max(np.abs(r.energy_balance(t) - r.initial_energy)) < 1e-11 * 0.5 * M * (shots * V0) ** 2
     assert [s["time"] for s in r.shots] == pytest.approx(shot_times)
+    assert [s["shot"] for s in r.shots] == [1, 2, 3, 4]
     for k, shot in enumerate(r.shots):
         last = k == shots - 1
         t_next = end if last else shot_times[k + 1]
         x_next = V0 * sum(t_next - s for s in shot_times[:k + 1])
         assert shot["max_barrel_displacement"] == pytest.approx(x_next, rel=1e-12)
         assert shot["time_of_max_barrel_displacement"] == pytest.approx(t_next, abs=1e-15)
-        assert shot["time_to_battery"] is None and shot["pulse_impulse"] is None
+        assert shot["time_to_battery"] is None
         if last:
-            assert shot["position_before_next"] is None and shot["in_battery_before_next"] is None
+            assert shot["position_at_next_shot"] is None and shot["in_battery_at_next_shot"] is None
         else:
-            assert shot["position_before_next"] == pytest.approx(x_next, rel=1e-12)
-            assert shot["velocity_before_next"] == pytest.approx((k + 1) * V0, rel=1e-12)  # before the jump
-            assert shot["in_battery_before_next"] is False
+            assert shot["position_at_next_shot"] == pytest.approx(x_next, rel=1e-12)
+            assert shot["velocity_at_next_shot"] == pytest.approx((k + 1) * V0, rel=1e-12)  # before the jump
+            assert shot["in_battery_at_next_shot"] is False
 
 
 def test_shots_after_the_end_time_do_not_fire():
@@ -217,8 +222,8 @@ def test_a_burst_of_pulses_on_a_free_mass_superposes_the_shifted_pulses():
     np.testing.assert_allclose(r.barrel_position(t), x, rtol=1e-11, atol=1e-16)
     np.testing.assert_allclose(r.barrel_velocity(t), v, rtol=1e-11, atol=1e-16)
     np.testing.assert_allclose(r.work_history(t)["breech_force"], 0.5 * M * v ** 2, rtol=1e-10, atol=1e-9)
-    assert [s["pulse_impulse"] for s in r.shots] == pytest.approx([IMPULSE] * shots, rel=1e-13)
     assert r.pulse_impulse == pytest.approx(IMPULSE, rel=1e-13)
+    assert r.metrics()["pulse_impulse"] == r.pulse_impulse and len(r.metrics()["shots"]) == shots
     breakpoints = {k * interval + s for k in range(shots) for s in TIMES} | {k * interval for k in range(1, shots)}
     assert breakpoints <= {seg.t0 for seg in r.segments}
     assert "burst" not in r.work  # the pulse repeats: no velocity jumps
@@ -252,16 +257,16 @@ def test_the_first_shot_of_a_burst_is_the_single_shot(single, burst):
     first = burst.shots[0]
     assert first["max_barrel_displacement"] == pytest.approx(single.max_barrel_displacement, rel=1e-10)
     assert first["time_of_max_barrel_displacement"] == pytest.approx(single.time_of_max_barrel_displacement, abs=1e-9)
-    assert first["position_before_next"] == pytest.approx(float(single.barrel_position(INTERVAL)), rel=1e-8)
-    assert first["velocity_before_next"] == pytest.approx(float(single.barrel_velocity(INTERVAL)), rel=1e-8)
-    assert first["in_battery_before_next"] == (abs(float(single.barrel_position(INTERVAL))) <= 1e-3)
+    assert first["position_at_next_shot"] == pytest.approx(float(single.barrel_position(INTERVAL)), rel=1e-8)
+    assert first["velocity_at_next_shot"] == pytest.approx(float(single.barrel_velocity(INTERVAL)), rel=1e-8)
+    assert first["in_battery_at_next_shot"] == (abs(float(single.barrel_position(INTERVAL))) <= 1e-3)
     back = first_return(single, single.time_of_max_barrel_displacement, INTERVAL)
     assert first["time_to_battery"] == pytest.approx(back, abs=1e-8)
 
 
 def test_each_later_shot_adds_v0_and_recoils_alike(burst):
     for k, shot in enumerate(burst.shots):
-        assert shot["time"] == k * INTERVAL
+        assert shot["time"] == k * INTERVAL and shot["shot"] == k + 1
         assert INTERVAL * k < shot["time_of_max_barrel_displacement"] < INTERVAL * k + 1.0
         # a shot fired near battery (a residual of a few cm and cm/s) recoils about as far as the first
         assert shot["max_barrel_displacement"] == pytest.approx(burst.shots[0]["max_barrel_displacement"], rel=0.05)
@@ -269,8 +274,8 @@ def test_each_later_shot_adds_v0_and_recoils_alike(burst):
         if k:
             before = burst.shots[k - 1]
             after = float(burst.barrel_velocity(shot["time"]))  # the state after the jump
-            assert after - before["velocity_before_next"] == pytest.approx(V0, rel=1e-12)
-            assert float(burst.barrel_position(shot["time"])) == pytest.approx(before["position_before_next"], rel=1e-12)
+            assert after - before["velocity_at_next_shot"] == pytest.approx(V0, rel=1e-12)
+            assert float(burst.barrel_position(shot["time"])) == pytest.approx(before["position_at_next_shot"], rel=1e-12)
     assert burst.max_barrel_displacement == max(s["max_barrel_displacement"] for s in burst.shots)
     t = np.linspace(0.0, 8.0, 8001)
     work = burst.work_history(t)["burst"]
@@ -283,7 +288,7 @@ def test_a_shot_fired_out_of_battery_recoils_further():
     single = solve_reference(simplified_model(), 2.0)
     r = solve_reference(simplified_model().with_changes(burst=Burst(2, 0.5)), 2.0)
     first, second = r.shots
-    assert first["in_battery_before_next"] is False and first["position_before_next"] > 0.1
+    assert first["in_battery_at_next_shot"] is False and first["position_at_next_shot"] > 0.1
     assert first["time_of_max_barrel_displacement"] == 0.5 and first["time_to_battery"] is None
     assert second["max_barrel_displacement"] > 1.5 * single.max_barrel_displacement
 
