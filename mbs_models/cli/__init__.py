@@ -146,19 +146,20 @@ def _cmd_design_brake(args) -> int:
     from ..outputs import atomic_write_json, atomic_write_text, prepare_output_dir
     from ..results.plotting import save_figure
     from ..scene.io import scene_to_toml
-    from ..studies.brake_design import compare_with_linear_damper, plot_comparison
+    from ..studies.brake_design import compare_with_linear_damper, design_brake, plot_comparison
 
     scene = _resolve_scene(args.scene)
     if args.recoil_length is None or not args.recoil_length > 0:
         raise SceneError("--recoil-length", f"must be a length > 0 m, got {args.recoil_length!r}")
-    out = prepare_output_dir(args.out)  # bad --out: exit 2 before any work
-    start = time.perf_counter()
     try:
-        comparison = compare_with_linear_damper(scene, args.recoil_length, args.accuracy)
+        design_brake(scene, args.recoil_length)  # a bad design: exit 2 before anything is written
     except SceneError as exc:
         if exc.key == "recoil_length":
             raise SceneError("--recoil-length", exc.message) from None
         raise
+    out = prepare_output_dir(args.out)  # bad --out: exit 2 before any work
+    start = time.perf_counter()
+    comparison = compare_with_linear_damper(scene, args.recoil_length, args.accuracy)
     atomic_write_text(out / "designed.toml", scene_to_toml(comparison.design.scene))
     save_figure(plot_comparison(comparison), out / "design_brake.png")
     data = comparison.to_dict()
