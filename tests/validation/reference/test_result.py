@@ -16,7 +16,7 @@ from mbs_models.scene import load_scene, model_i, model_ii, simplified_model
 from validation.reference import solve_reference
 from validation.reference.model import GROUND
 
-END = 2.0
+END = 3.0  # s: the every-element scenes fire a burst (last shot 1.2 s) and return onto the battery stop after it
 
 
 #: two absorbers (front: ground, hunt-crossley, gap 0; rear: barrel, lankarani-nikravesh, gap 10 mm)
@@ -80,10 +80,15 @@ def test_histories_are_derivatives_of_each_other(key, solved):
     r = solved(key)
     t = grid(20001)
     h = t[1] - t[0]
+    # a shot of a burst jumps the velocity: the central differences next to it do not see it
+    jumps = [s for impulse in r.model.impulses for s in impulse.times]
+    away = np.all([np.abs(t - s) > 1.5 * h for s in jumps], axis=0) if jumps else np.ones_like(t, dtype=bool)
+    assert away.mean() > 0.99
     for body in r.bodies:
         x, v, a = r.position(body, t), r.velocity(body, t), r.acceleration(body, t)
         scale_v, scale_a = np.max(np.abs(v)) + 1e-9, np.max(np.abs(a)) + 1e-9
-        np.testing.assert_allclose(np.gradient(x, h)[1:-1], v[1:-1], atol=1e-3 * scale_v, err_msg=body)
+        np.testing.assert_allclose(np.gradient(x, h)[1:-1][away[1:-1]], v[1:-1][away[1:-1]], atol=1e-3 * scale_v,
+                                   err_msg=body)
         smooth = np.abs(np.gradient(v, h) - a) < 1e-2 * scale_a  # velocity kinks at impacts are excluded
         assert smooth.mean() > 0.97, body
 
@@ -136,6 +141,7 @@ def test_energy_balance_closes_part_by_part(key, solved, scenes):
     t = grid()
     total = sum(r.kinetic_energy(t).values()) + sum(r.stored_energy(t).values()) + \
         sum(r.dissipated_energy_history(t).values())
+    total = total - sum(r.work_history(t).values(), 0.0 * t)  # the work of a burst's later shots
     np.testing.assert_allclose(total, r.energy_balance(t), rtol=1e-13)
     assert r.initial_energy == pytest.approx(0.5 * scenes[key].barrel.mass * scenes[key].initial_velocity ** 2,
                                              rel=1e-15)
