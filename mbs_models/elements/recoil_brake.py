@@ -176,6 +176,7 @@ class RecoilBrakeConnector(Connector):
         super().__init__(RecoilBrake.TABLE, RecoilBrake.TABLE, GROUND, BARREL)
         self.brake = brake
         self._scene = scene
+        self._largest_speed = None
 
     def law(self, d, rate, ops: Ops):
         return recoil_brake_force(d, rate, self.brake, ops)
@@ -200,6 +201,8 @@ class RecoilBrakeConnector(Connector):
         scene = self._scene
         if scene is None:
             return 0.0
+        if self._largest_speed is not None:
+            return self._largest_speed
         energy = scene.initial_kinetic_energy
         for name, table in scene.elements():
             if table is self.brake:
@@ -207,13 +210,24 @@ class RecoilBrakeConnector(Connector):
             for connector in table.connectors(scene, name):
                 if connector.stores_energy:
                     energy += float(connector.stored_energy(0.0))
-        return math.sqrt(2.0 * max(energy, 0.0) / scene.barrel.mass)
+        self._largest_speed = math.sqrt(2.0 * max(energy, 0.0) / scene.barrel.mass)
+        return self._largest_speed
 
     @property
     def linear_damping(self) -> float:
         """The tangent damping ``dF/dv = 2 K |v|`` (N s/m) at its largest during the run: the smallest area
         and the largest speed (:meth:`largest_speed`), the stiffest linearisation a fixed step must survive."""
         return 2.0 * self.brake.coefficient / self.brake.smallest_area() ** 2 * self.largest_speed()
+
+    @property
+    def first_step_limit(self) -> float:
+        """``M / (2 K_max |v|max)`` (s): the time constant of the brake at its stiffest (:attr:`linear_damping`).
+
+        A brake far stiffer than the solver's maximum step (areas of 1 % of the example's: a time constant of
+        ~1e-5 s) would otherwise be met with a 5 ms first step, in which ``v|v|`` grows without bound and the
+        error estimate with it; inf without a scene or without motion."""
+        damping = self.linear_damping
+        return self._scene.barrel.mass / damping if damping > 0 else math.inf
 
 
 def add_recoil_brake(mbs, marker_ground, marker_barrel, brake: RecoilBrake,
