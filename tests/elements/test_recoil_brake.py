@@ -32,6 +32,7 @@ PRESETS = list(TOLERANCES)
 RHO, A, CD = 870.0, 0.012, 0.7                        # kg/m^3, m^2, 1 (DESIGN.md's example)
 M, K_SPRING = 5600.0, 27500.0                          # kg, N/m (the paper's barrel and recoil spring)
 TABLE = ((0.0, 5.0e-4), (0.1, 3.5e-4), (0.2, 2.0e-4))  # (stroke m, area m^2): the shipped example's orifice
+COUNTER = ((0.0, 2.0e-4), (0.2, 4.0e-4))               # and its counter-recoil orifice
 SHIPPED = load_scene(scene_path("recoil_brake"))
 
 
@@ -83,7 +84,7 @@ END = 4.0  # s: the first recoil, the return through the counter-recoil orifice 
 
 # ================================================================================================ the table
 def test_the_shipped_example_is_the_simplified_model_with_a_tabulated_brake():
-    assert SHIPPED == paper_barrel(brake(TABLE, 1.0e-4)).with_changes(name=SHIPPED.name)
+    assert SHIPPED == paper_barrel(brake(TABLE, COUNTER)).with_changes(name=SHIPPED.name)
     assert SHIPPED.recoil_damper is None and not SHIPPED.absorbers
 
 
@@ -291,18 +292,15 @@ def test_the_reference_switches_at_v_0_and_at_every_stroke_point():
     """The reference's segments: each one's mode is the branch of the sign of v and the piece of the table its
     stroke lies on (checked on the segment's interior), and every stroke point passed ends a segment."""
     r = solve_reference(SHIPPED, END)
-    strokes = [x for x, _ in TABLE]
     for segment in r.segments:
         t = np.linspace(segment.t0, segment.t1, 9)[1:-1]
         x, v = r.barrel_position(t), r.velocity("barrel", t)
         state = segment.mode["recoil_brake"]
         assert np.all(v > 0) if state.recoil else np.all(v < 0), segment
-        if state.recoil:  # the counter-recoil orifice is a constant: one piece
-            assert np.all(np.searchsorted(strokes, x, side="right") == state.piece), segment
-        else:
-            assert state.piece == 0
+        strokes = [stroke for stroke, _ in (TABLE if state.recoil else COUNTER)]
+        assert np.all(np.searchsorted(strokes, x, side="right") == state.piece), segment
     boundaries = [s.t0 for s in r.segments]
-    for stroke in strokes[1:]:  # x = 0.1 and 0.2 m are passed while recoiling: a segment starts there
+    for stroke in (0.0, 0.1, 0.2):  # passed while recoiling (0.1, 0.2) or returning (0.2, 0): segments start there
         assert any(abs(r.barrel_position(t) - stroke) < 1e-9 for t in boundaries), stroke
     modes = [segment.mode for segment in r.segments]
     assert all(a != b for a, b in zip(modes, modes[1:]))  # a segment ends only where the mode changes
@@ -412,7 +410,7 @@ def test_the_energy_balance_closes_element_by_element(accuracy):
     total = sum(sum(parts.values()) for parts in energy.values())
     assert abs(total - e0) <= TOLERANCES[accuracy]["energy"] * e0
     history = result.dissipated_energy_history["recoil_brake"]
-    assert np.all(np.diff(history) >= 0.0) and history[-1] > 0.99 * e0
+    assert np.all(np.diff(history) >= 0.0) and history[-1] > 0.0
     ref = reference_for(SHIPPED, END, (), accuracy)
     assert abs(ref.dissipated_energy["recoil_brake"] - history[-1]) <= TOLERANCES[accuracy]["metric"] * e0
 
@@ -450,16 +448,18 @@ def test_a_very_stiff_brake_stays_finite_opposes_the_motion_and_agrees_with_the_
 
 def test_fixed_steps_beyond_the_linearised_brake_are_refused():
     """The stability checks linearise the brake to ``dF/dv = 2 K v`` at the smallest area and the largest speed
-    (sqrt(2 E0 / M) = v0 here): RK44 is stable up to h |lambda| = 2.785 on the real axis, so its step limit is
-    about 2.785 M / (2 K_max v0); a step beyond it is refused before solving."""
-    K_max = RHO * A ** 3 / (2 * CD ** 2 * 1.0e-4 ** 2)  # the counter-recoil orifice is the smallest
-    damping = 2 * K_max * SHIPPED.initial_velocity
-    limit = stable_step_limit(SHIPPED, "RK44", END)
-    assert limit == pytest.approx(2.785 * M / damping, rel=0.05)
+    (sqrt(2 E0 / M) = v0 here): with the spring, M x'' + c x' + k x = 0 has the fastest rate
+    c / 2M + sqrt((c / 2M)^2 - k / M); RK44 is stable up to h |lambda| = 2.785 on the real axis, so its step
+    limit is 2.785 over that rate; a step beyond it is refused before solving."""
+    for factor in (1.0, 0.01):
+        scene = scaled(SHIPPED, factor)
+        K_max = RHO * A ** 3 / (2 * CD ** 2 * (2.0e-4 * factor) ** 2)  # the smallest area of either orifice
+        damping = 2 * K_max * SHIPPED.initial_velocity
+        rate = damping / (2 * M) + math.sqrt((damping / (2 * M)) ** 2 - K_SPRING / M)
+        limit = stable_step_limit(scene, "RK44", END)
+        assert limit == pytest.approx(2.785 / rate, rel=0.01)
     with pytest.raises(SceneError, match="unsafe"):
-        simulate(SHIPPED, END, SolverSettings(solver="RK44", step=1.5 * limit))
-    stiff = scaled(SHIPPED, 0.01)
-    assert stable_step_limit(stiff, "RK44", END) == pytest.approx(limit * 1e-4, rel=0.05)
+        simulate(scene, END, SolverSettings(solver="RK44", step=1.5 * limit))
 
 
 # ================================================================================================ backends
@@ -502,11 +502,11 @@ def test_the_force_bound_is_the_design_bound_in_both_implementations(name):
     engine = fm.EnergyBounds(scene)
     reference = ReferenceBounds(build_model(scene))
     table = scene.recoil_brake
-    counter = math.inf if table.counter_recoil_orifice_area is None else table.counter_recoil_orifice_area
     for energy in (1.0, 50.0, 1336.6, 4000.0):
         reach = math.sqrt(2 * energy / K_SPRING)
         grid = np.linspace(-reach, reach, 200001)
-        a_min = min(np.min(area_of(table.orifice_area, grid)), counter)
+        a_min = min(np.min(area_of(area, grid)) for area in (table.orifice_area, table.counter_recoil_orifice_area)
+                    if area is not None)
         expected = K_SPRING * reach + RHO * A ** 3 * (2 * energy / M) / (2 * CD ** 2 * a_min ** 2)
         assert engine.support_force_bound(energy) == pytest.approx(expected, rel=1e-9)
         assert reference.bounds(energy)["support"] == pytest.approx(expected, rel=1e-9)
