@@ -71,10 +71,10 @@ def _check(scene: Scene, recoil_length: float) -> None:
                                      "remove the [[absorber]] tables")
     if getattr(scene, "burst", None) is not None and scene.burst.shots > 1:
         raise SceneError("burst", "the design is for one shot: remove [burst] (the designed scene may add it back)")
-    stop = getattr(scene, "recoil_stop", None)
-    if stop is not None and stop.position <= recoil_length:
-        raise SceneError("recoil_length", f"must be shorter than the recoil stop's position ({stop.position:g} m), "
-                                          f"got {recoil_length:g} m")
+    for contact in Mechanism(scene).stop_contacts:  # a stop the barrel would hit within the stroke
+        if contact.a == GROUND and contact.b == BARREL and contact.offset <= recoil_length:
+            raise SceneError("recoil_length", f"must be shorter than the position of [{contact.element}] "
+                                              f"({contact.offset:g} m), got {recoil_length:g} m")
 
 
 def other_resistance(scene: Scene, x: np.ndarray, v: np.ndarray) -> np.ndarray:
