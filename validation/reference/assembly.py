@@ -8,12 +8,12 @@ error: the reference would silently leave an effect out.
 
 from __future__ import annotations
 
-from .model import BARREL, AbsorberRole, Body, Connector, Model, ReferenceModelError
+from .model import BARREL, AbsorberRole, Body, Connector, Load, Model, ReferenceModelError
 from .terms import TERMS
 
 
 class ModelBuilder:
-    """What the terms add while a scene is read: bodies, connectors, absorbers and stops (by name)."""
+    """What the terms add while a scene is read: bodies, connectors, absorbers and stops (by name), loads."""
 
     def __init__(self, scene):
         self.scene = scene
@@ -21,6 +21,7 @@ class ModelBuilder:
         self.connectors: list[Connector] = []
         self.absorbers: list[AbsorberRole] = []
         self.stops: list[str] = []
+        self.loads: list[Load] = []
 
     def add_body(self, body: Body) -> None:
         self.bodies.append(body)
@@ -34,10 +35,14 @@ class ModelBuilder:
     def add_stop(self, name: str) -> None:
         self.stops.append(name)
 
+    def add_load(self, name: str, body: str, force: float) -> None:
+        """A constant external force ``force`` (N) on ``body`` (:class:`~validation.reference.model.Load`)."""
+        self.loads.append(Load(name, body, float(force)))
+
     def model(self) -> Model:
         """The model: the barrel first, then the other bodies in the order they were added."""
         bodies = sorted(self.bodies, key=lambda b: b.name != BARREL)
-        return Model(getattr(self.scene, "name", ""), bodies, self.connectors, self.absorbers, self.stops)
+        return Model(getattr(self.scene, "name", ""), bodies, self.connectors, self.absorbers, self.stops, self.loads)
 
 
 def table_name(key: str) -> str:

@@ -7,6 +7,7 @@ joins them, for one :class:`~validation.reference.model.Mode`, into one function
 
     x0, v0, x1, v1, _, _, _ = y.tolist()       # positions and velocities of the bodies
     f0 = f1 = fg = 0.0                         # forces on the bodies and on the ground
+    f0 += 27468.0                              # external loads (gravity), on their body only
     <connector 0: sets F0 (and P0)>;  fg += F0;  f0 -= F0      # F pushes b to -x, a to +x
     ...                                        # constraints (a sliding contact) last
     return array([v0, f0 / M, v1, f1 / m, P1, P2, P3])
@@ -44,6 +45,8 @@ def source(model, mode, kind: str, omit: int | None = None) -> str:
     names = [n for i in range(nb) for n in (f"x{i}", f"v{i}")] + ["_"] * (model.n_states - 2 * nb)
     unpack = "y" if kind == "array" else "y.tolist()"
     body = [f"{', '.join(names)}, = {unpack}", " = ".join([f"f{i}" for i in range(nb)] + ["fg", "0.0"])]
+    for load, (i, force) in zip(model.loads, model.load_forces):  # external loads: on their body only
+        body += [f"# load {load.name}", f"f{i} += {force!r}"]
     blocks, late = [], []
     forces, powers = {}, {}
     for j, (c, state) in enumerate(zip(model.connectors, mode.states)):

@@ -5,7 +5,7 @@ the recoil direction, 0 at the start).  Every force is a :class:`Connector` betw
 ``b`` (bodies, or the ground :data:`GROUND`) with relative coordinate ``d = x_b - x_a`` (m) and rate
 ``d' = v_b - v_a`` (m/s); its force ``F`` (N) pushes ``b`` towards -x and ``a`` towards +x::
 
-    m_i x_i'' = sum_{connectors with a = i} F  -  sum_{connectors with b = i} F
+    m_i x_i'' = sum_{connectors with a = i} F  -  sum_{connectors with b = i} F  +  sum_{loads on i} F_load
     S         = sum_{connectors with a = ground} F  -  sum_{connectors with b = ground} F   (support force)
 
 State vector ``y``: ``[x_0, v_0, x_1, v_1, ..., D_0, D_1, ...]`` -- position (m) and velocity (m/s) of
@@ -201,6 +201,18 @@ class Mode:
 
 
 @dataclass(frozen=True)
+class Load:
+    """A constant external force ``force`` (N, positive in the recoil direction) on body ``body``, named ``name``
+    (gravity along an inclined cradle).  It acts on the body alone (not on the ground: no support force); its
+    work ``W = force (x_body(t) - x_body(0))`` (J) enters the energy balance: kinetic + stored + dissipated - W
+    stays the initial energy.  A load acting for ever leaves the mechanism without an energy bound."""
+
+    name: str
+    body: str
+    force: float
+
+
+@dataclass(frozen=True)
 class AbsorberRole:
     """An absorber: its body, its actuator connector (None if k_r = c_r = 0) and its contact (names)."""
 
@@ -224,10 +236,11 @@ class Evaluation:
 class Model:
     """Bodies (barrel first), connectors (scene order) and roles (absorbers, stops) of one scene."""
 
-    def __init__(self, name: str, bodies, connectors, absorbers=(), stops=()):
+    def __init__(self, name: str, bodies, connectors, absorbers=(), stops=(), loads=()):
         self.name = name
         self.bodies = tuple(bodies)
         self.connectors = tuple(connectors)
+        self.loads = tuple(loads)
         self.absorbers = tuple(absorbers)
         self.stops = tuple(stops)
         if not self.bodies or self.bodies[0].name != BARREL:
@@ -238,6 +251,11 @@ class Model:
             if duplicate is not None:
                 raise ReferenceModelError(f"{duplicate!r} names two {what}s")
         self.body_index = {n: i for i, n in enumerate(names)}
+        for load in self.loads:
+            if load.body not in self.body_index:
+                raise ReferenceModelError(f"load {load.name!r} acts on {load.body!r}, which is not a body")
+        #: (body index, force N) of every load
+        self.load_forces = tuple((self.body_index[load.body], float(load.force)) for load in self.loads)
         self.masses = [b.mass for b in self.bodies]
         self.n_bodies = len(self.bodies)
         self.dissipating = tuple(c for c in self.connectors if c.dissipates)
@@ -311,6 +329,10 @@ class Model:
     def dissipated_energies(self, y) -> dict[str, Any]:
         """D per dissipating connector (J): the state's last entries."""
         return {c.name: y[c.di] for c in self.dissipating}
+
+    def work_energies(self, y) -> dict[str, Any]:
+        """Work done by each load since t = 0 (J): ``force x_body`` (every body starts at x = 0)."""
+        return {load.name: force * y[2 * i] for load, (i, force) in zip(self.loads, self.load_forces)}
 
     def mechanical_energy(self, y):
         """Kinetic + stored energy (J) of a state or a batch."""

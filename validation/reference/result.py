@@ -320,18 +320,24 @@ class ReferenceResult:
         ``contact``, ...: only connectors that exist and dissipate)."""
         return {k: float(v) for k, v in self.dissipated_energy_history(self.end_time).items()}
 
+    def work(self, t) -> dict[str, np.ndarray]:
+        """Work done on the mechanism by each external load since t = 0 (J) at ``t``."""
+        return self.model.work_energies(self.state(t))
+
     def energy_components(self, t) -> dict[str, np.ndarray]:
         """The parts of the energy balance (J): ``kinetic:<body>``, ``stored:<connector>``,
-        ``dissipated:<connector>``; they sum to :meth:`energy_balance`."""
+        ``dissipated:<connector>``, and ``work:<load>`` (the work of an external load); kinetic + stored +
+        dissipated - work is :meth:`energy_balance`."""
         y = self.state(t)
         model = self.model
         return {**{f"kinetic:{k}": v for k, v in model.kinetic_energies(y).items()},
                 **{f"stored:{k}": v for k, v in model.stored_energies(y).items()},
-                **{f"dissipated:{k}": v for k, v in model.dissipated_energies(y).items()}}
+                **{f"dissipated:{k}": v for k, v in model.dissipated_energies(y).items()},
+                **{f"work:{k}": v for k, v in model.work_energies(y).items()}}
 
     def energy_balance(self, t):
-        """Total energy (J): kinetic + stored + dissipated; constant = initial_energy."""
-        return sum(self.energy_components(t).values())
+        """Total energy (J): kinetic + stored + dissipated - work of the loads; constant = initial_energy."""
+        return sum(-v if k.startswith("work:") else v for k, v in self.energy_components(t).items())
 
     @property
     def initial_energy(self) -> float:
