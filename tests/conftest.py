@@ -237,7 +237,7 @@ def every_element():
 def design_connector_names(scene) -> tuple[str, ...]:
     """DESIGN.md's connector names of ``scene`` in assembly order: ``recoil_spring`` and ``recoil_damper``, an
     absorber's ``<name>_damper`` and ``<name>_contact`` (``absorber_damper`` and ``contact`` with one absorber),
-    and for every other table but the barrel and the firing one connector named like its table.  (Every
+    and for every other table but the barrel, the firing and the burst one connector named like its table.  (Every
     coefficient non-zero: a zero spring or damper adds no connector.)"""
     several = len(scene.absorbers) > 1
     absorbers = set(scene.absorber_names())
@@ -245,7 +245,7 @@ def design_connector_names(scene) -> tuple[str, ...]:
     for name, _ in scene.elements():
         if name in absorbers:
             names += [f"{name}_damper", f"{name}_contact"] if several else ["absorber_damper", "contact"]
-        elif name not in ("barrel", "firing"):
+        elif name not in ("barrel", "firing", "burst"):  # the shots add no connector
             names.append(name)
     return tuple(names)
 

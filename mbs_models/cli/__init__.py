@@ -142,6 +142,43 @@ def _cmd_contact_laws(args) -> int:
     return EXIT_OK
 
 
+def _cmd_design_brake(args) -> int:
+    from ..outputs import atomic_write_json, atomic_write_text, prepare_output_dir
+    from ..results.plotting import save_figure
+    from ..scene.io import scene_to_toml
+    from ..studies.brake_design import compare_with_linear_damper, design_brake, plot_comparison
+
+    scene = _resolve_scene(args.scene)
+    if args.recoil_length is None or not args.recoil_length > 0:
+        raise SceneError("--recoil-length", f"must be a length > 0 m, got {args.recoil_length!r}")
+    try:
+        design_brake(scene, args.recoil_length)  # a bad design: exit 2 before anything is written
+    except SceneError as exc:
+        if exc.key == "recoil_length":
+            raise SceneError("--recoil-length", exc.message) from None
+        raise
+    out = prepare_output_dir(args.out)  # bad --out: exit 2 before any work
+    start = time.perf_counter()
+    comparison = compare_with_linear_damper(scene, args.recoil_length, args.accuracy)
+    atomic_write_text(out / "designed.toml", scene_to_toml(comparison.design.scene))
+    save_figure(plot_comparison(comparison), out / "design_brake.png")
+    data = comparison.to_dict()
+    atomic_write_json(out / "design_brake.json", data)
+    if args.json:
+        print(json.dumps(data, indent=2, allow_nan=False))
+    else:
+        d, lin = data["designed"], data["linear_damper"]
+        print(f"constant resistance R = {data['constant_resistance'] / 1e3:.3f} kN over {args.recoil_length:g} m "
+              f"(flat to {100 * data['resistance_flatness_over_90_percent']:.2f} % over 90 % of the stroke)")
+        print(f"  designed brake   recoil length {d['recoil_length']:.4f} m, peak support force "
+              f"{d['peak_support_force'] / 1e3:.3f} kN")
+        print(f"  linear damper    recoil length {lin['recoil_length']:.4f} m, peak support force "
+              f"{lin['peak_support_force'] / 1e3:.3f} kN (c = {lin['recoil']:.0f} / {lin['counter_recoil']:.0f} N s/m)")
+        print(f"wrote designed.toml, design_brake.png, design_brake.json to {out} in "
+              f"{time.perf_counter() - start:.1f} s")
+    return EXIT_OK
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="recoil", description="Recoil mechanisms with impact absorbers (Exudyn).")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
@@ -195,6 +232,15 @@ def build_parser() -> argparse.ArgumentParser:
     laws.add_argument("--accuracy", default="standard", choices=("draft", "standard", "reference"))
     laws.add_argument("--json", action="store_true", help="print the study as JSON")
     laws.set_defaults(handler=_cmd_contact_laws)
+
+    design = sub.add_parser("design-brake", help="design the recoil brake's orifice for a constant resistance over "
+                                                  "a recoil length, and compare it with a linear damper")
+    design.add_argument("scene", help="scene TOML file or shipped scene (a barrel without absorbers, e.g. simplified)")
+    design.add_argument("--recoil-length", type=float, required=True, metavar="L", help="recoil length in m")
+    design.add_argument("--out", default="design-brake", help="output directory (default ./design-brake)")
+    design.add_argument("--accuracy", default="standard", choices=("draft", "standard", "reference"))
+    design.add_argument("--json", action="store_true", help="print the comparison as JSON")
+    design.set_defaults(handler=_cmd_design_brake)
     return parser
 
 

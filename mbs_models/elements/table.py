@@ -153,6 +153,9 @@ class Table:
         values = dict(data)
         for name, nested in cls.NESTED.items():
             if name in values:
+                if nested.SINCE_VERSION > version:
+                    raise SceneError(f"{key}.{name}", f"[{key}.{name}] needs a version-{nested.SINCE_VERSION} scene "
+                                                      f"(put version = {nested.SINCE_VERSION} at the top)")
                 values[name] = nested.from_mapping(values[name], f"{key}.{name}", version)
         try:
             return cls(**values)

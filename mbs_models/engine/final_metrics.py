@@ -44,6 +44,10 @@ Finality (what :class:`FinalityTracker` decides from the states it is shown)
 Ties keep the earliest time, as the peak refinement does.  The observed values are samples of the
 solution, hence lower bounds of its refined maxima: a metric proven final from samples is final.
 
+External inputs: a shot of a burst and a breech-force pulse add energy; the bounds are applied only
+to states after the last of them (:attr:`Mechanism.last_input_time`); a load that never ends (gravity
+along an inclined cradle) leaves the scene without a bound (:func:`dissipative` is False).
+
 Numerical slack: a numerical solution dissipates energy only up to its integration error, so the
 bounds use ``E (1 + ENERGY_SLACK)``.  :func:`mbs_models.simulate` trusts an early stop only if the
 solution's energy rose by no more than that fraction anywhere in the simulated window
@@ -97,8 +101,11 @@ def check_metric_names(names, key: str = "stop_when_final") -> tuple[str, ...]:
 
 
 def dissipative(scene: Scene) -> bool:
-    """True when the scene's mechanical energy never increases (every reading but literal_lambda_sign)."""
-    return not scene.conventions.literal_lambda_sign
+    """True when the scene's mechanical energy never increases after its last external input: every
+    reading but literal_lambda_sign, and no load that acts for ever (gravity along an inclined cradle)."""
+    if scene.conventions.literal_lambda_sign:
+        return False
+    return math.isfinite(Mechanism(scene).last_input_time)
 
 
 class _QuadraticForm:
@@ -324,6 +331,8 @@ class FinalityTracker:
         self.requested = check_metric_names(requested)
         self.impact_threshold = float(impact_threshold)
         self.enabled = dissipative(self.scene)
+        #: the energy bounds hold only after the last shot or pulse (s): states before it prove nothing
+        self.after = self.mechanism.last_input_time
         self.max_barrel_position = -math.inf
         self.max_velocity = [-math.inf] * len(self.mechanism.bodies)
         self.max_contact_force = [0.0] * len(self.bounds.contacts)
@@ -382,7 +391,7 @@ class FinalityTracker:
     def check(self, t: float, x, v, forces, names: Iterable[str] = FINAL_METRICS) -> None:
         """Mark those of ``names`` that the energy at this state (contact forces ``forces`` N, in
         :attr:`EnergyBounds.contacts` order) proves final."""
-        if not self.enabled:
+        if not self.enabled or t < self.after:
             return
         todo = [name for name in names if name not in self.final]
         if not todo:

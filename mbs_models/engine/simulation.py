@@ -64,11 +64,15 @@ def _check_arguments(scene: Scene, end_time: float, impact_threshold: float) -> 
         raise SceneError("impact_threshold", f"must be a force >= 0 N, got {impact_threshold!r}")
 
 
-def exudyn_simulation_settings(settings: SolverSettings, end_time: float):
-    """Translate :class:`SolverSettings` into Exudyn ``SimulationSettings`` for a run to ``end_time``."""
+def exudyn_simulation_settings(settings: SolverSettings, end_time: float, start_time: float = 0.0):
+    """Translate :class:`SolverSettings` into Exudyn ``SimulationSettings`` for a run from ``start_time``
+    (s, default 0) to ``end_time`` (s)."""
     ss = exudyn.SimulationSettings()
     ti = ss.timeIntegration
     ti.endTime = float(end_time)
+    if start_time:
+        ti.startTime = float(start_time)
+    span = float(end_time) - float(start_time)
     ti.verboseMode = 0
     ss.show.statistics = False
     ss.show.computationTime = False
@@ -76,16 +80,16 @@ def exudyn_simulation_settings(settings: SolverSettings, end_time: float):
     ss.solution.sensors.writePeriod = 0.0  # every step: extrema are refined between step ends
     if settings.adaptive:
         ti.automaticStepSize = True
-        ti.numberOfSteps = max(1, math.ceil(end_time / settings.max_step))
+        ti.numberOfSteps = max(1, math.ceil(span / settings.max_step))
         ti.relativeTolerance = settings.relative_tolerance
         ti.absoluteTolerance = settings.absolute_tolerance
         ti.minimumStepSize = min(1e-12, settings.max_step)
     else:
         ti.automaticStepSize = False
-        steps = max(1, math.ceil(end_time / settings.step - 1e-9))
+        steps = max(1, math.ceil(span / settings.step - 1e-9))
         ti.numberOfSteps = steps
         if steps > MAX_FIXED_STEP_SAMPLES:
-            ss.solution.sensors.writePeriod = end_time / MAX_FIXED_STEP_SAMPLES
+            ss.solution.sensors.writePeriod = span / MAX_FIXED_STEP_SAMPLES
         if settings.implicit:
             ti.newton.relativeTolerance = 1e-10
             ti.newton.absoluteTolerance = 1e-12
@@ -141,7 +145,7 @@ def _pre_step_function(assembly: Assembly, budget: StepBudget | None, tracker: F
         ib = None if contact.b == "ground" else assembly.coordinates[contact.b]
         captures.append((contact.capture, ia, ib))
     calls = [0]
-    solver = []
+    solver = []  # Exudyn's time-integration state, cached on the first call of each solve
 
     def pre_step(mbs, t):
         if budget is not None and not budget(mbs, t):
@@ -168,24 +172,34 @@ def _pre_step_function(assembly: Assembly, budget: StepBudget | None, tracker: F
                 return False
         return True
 
+    pre_step.new_solve = solver.clear  # a segmented run calls it before each segment's solve
     return pre_step
 
 
 def _solve(assembly: Assembly, settings: SolverSettings, end_time: float,
-           tracker: FinalityTracker | None = None) -> tuple[int, float]:
-    """Run Exudyn; return the number of steps and the simulated end time (s).
+           tracker: FinalityTracker | None = None, start_time: float = 0.0,
+           run: dict | None = None) -> tuple[int, float]:
+    """Run Exudyn from ``start_time`` to ``end_time`` (s); return the number of steps and the simulated end time.
 
     The solve ends at ``end_time``, or earlier only when ``tracker`` proved every requested metric
-    final.  Raise SimulationError on any failure (including any other early stop).
+    final.  Raise SimulationError on any failure (including any other early stop).  ``run`` carries
+    what the segments of one run share (the step budget and the pre-step function); None: a run of one
+    segment.
     """
     mbs = assembly.mbs
-    ss = exudyn_simulation_settings(settings, end_time)
+    ss = exudyn_simulation_settings(settings, end_time, start_time)
     solver_type = getattr(exudyn.DynamicSolverType, settings.solver)
-    budget = None
-    if settings.adaptive and assembly.mechanism.contacts:
-        budget = StepBudget(step_budget(end_time))
-    if budget is not None or tracker is not None or assembly.mechanism.capturing_contacts:
-        mbs.SetPreStepUserFunction(_pre_step_function(assembly, budget, tracker))
+    run = {} if run is None else run
+    if "budget" not in run:
+        run["budget"] = None
+        if settings.adaptive and assembly.mechanism.contacts:
+            run["budget"] = StepBudget(step_budget(run.get("end_time", end_time)))
+        if run["budget"] is not None or tracker is not None or assembly.mechanism.capturing_contacts:
+            run["pre_step"] = _pre_step_function(assembly, run["budget"], tracker)
+            mbs.SetPreStepUserFunction(run["pre_step"])
+    elif "pre_step" in run:
+        run["pre_step"].new_solve()
+    budget = run["budget"]
     print_to_console = exudyn.config.printToConsole
     exudyn.config.printToConsole = False  # Exudyn's own failure banner; we raise with the reason instead
     try:
@@ -209,7 +223,7 @@ def _solve(assembly: Assembly, settings: SolverSettings, end_time: float,
     return int(iteration.currentStepIndex), float(iteration.currentTime)
 
 
-def _initial_accelerations(assembly: Assembly) -> dict[str, float]:
+def _initial_accelerations(assembly: Assembly, t: float = 0.0) -> dict[str, float]:
     """Accelerations (m/s^2) of each body at the initial state, from Exudyn's own force evaluation.
 
     Exudyn's explicit solvers record the acceleration sensors at t = 0 as 0 (nothing is evaluated
@@ -233,7 +247,10 @@ def _initial_accelerations(assembly: Assembly) -> dict[str, float]:
     except Exception as exc:  # a user function that raises at the initial state
         message = " ".join(str(exc).split())
         raise SimulationError(f"evaluating the forces at t = 0 failed: {message[:500]}") from exc
-    accelerations = np.linalg.solve(mass, -lhs)
+    rhs = -lhs
+    for load in assembly.mechanism.loads:  # external loads at t (the objects' LHS does not hold them)
+        rhs[data.GetNodeLTGODE2(assembly.nodes[load.body])[0]] += float(load.force(np.array([t]))[0])
+    accelerations = np.linalg.solve(mass, rhs)
     return {body: float(accelerations[data.GetNodeLTGODE2(node)[0]]) for body, node in assembly.nodes.items()}
 
 
@@ -241,33 +258,99 @@ def _stored(assembly: Assembly, name: str) -> np.ndarray:
     return np.asarray(assembly.mbs.GetSensorStoredData(assembly.sensors[name]), dtype=float)
 
 
-def _collect(assembly: Assembly, end_time: float, settings: SolverSettings,
-             initial_accelerations: dict[str, float] | None = None) -> Samples:
-    """Read the sensors into :class:`Samples`; raise SimulationError for NaN/inf or missing output."""
+def _read_segment(assembly: Assembly, settings: SolverSettings, start_time: float = 0.0,
+                  initial_accelerations: dict[str, float] | None = None) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """The sensors of the last solve: (time s, values by sensor name), duplicate time stamps dropped;
+    SimulationError for NaN/inf."""
     columns = {name: _stored(assembly, name) for name in assembly.sensors}
     for body, value in (initial_accelerations or {}).items():
         data = columns[f"{body}_acceleration"]
-        if len(data) and data[0, 0] == 0.0:
-            data[0, 1] = value  # Exudyn records 0 at t = 0 (see _initial_accelerations)
-    time = columns["barrel_position"][:, 0]
-    if len(time) < 2:
-        raise SimulationError(f"Exudyn {settings.solver} produced fewer than two output samples")
+        if len(data) and data[0, 0] == start_time:
+            data[0, 1] = value  # Exudyn records 0 at the start (see _initial_accelerations)
     for name, data in columns.items():
         if not np.all(np.isfinite(data)):
             first = int(np.flatnonzero(~np.all(np.isfinite(data), axis=1))[0])
             raise SimulationError(f"Exudyn {settings.solver} produced a non-finite {name.replace('_', ' ')} at "
                                   f"t = {data[first, 0]:.6g} s (the solve diverged; try a smaller step or "
                                   "tighter tolerance)")
+    time = columns["barrel_position"][:, 0]
+    keep = np.concatenate([[True], np.diff(time) > 0])  # drop duplicate time stamps, if any
+    return time[keep], {name: data[keep, 1] for name, data in columns.items()}
+
+
+def _collect(assembly: Assembly, end_time: float, settings: SolverSettings,
+             initial_accelerations: dict[str, float] | None = None, segments: list | None = None) -> Samples:
+    """Read the sensors into :class:`Samples`; raise SimulationError for NaN/inf or missing output.
+
+    ``segments``: the ``(time, values)`` of every segment of a segmented run (:func:`_run_segments`),
+    joined in order; the sample at a segment boundary appears twice, before and after it (a velocity
+    jump of a shot, a jump of the breech force): a zero-length interval the post-processing skips.
+    """
+    if segments is None:
+        segments = [_read_segment(assembly, settings, 0.0, initial_accelerations)]
+    time = np.concatenate([t for t, _ in segments])
+    values = {name: np.concatenate([v[name] for _, v in segments]) for name in assembly.sensors}
+    if len(time) < 2:
+        raise SimulationError(f"Exudyn {settings.solver} produced fewer than two output samples")
     if abs(time[-1] - end_time) > 1e-6 * max(1.0, end_time):
         raise SimulationError(f"Exudyn {settings.solver} output ends at t = {time[-1]:.6g} s, not at {end_time:g} s")
-    keep = np.concatenate([[True], np.diff(time) > 0])  # drop duplicate time stamps, if any
-    values = {name: data[keep, 1] for name, data in columns.items()}
     bodies = [body.name for body in assembly.mechanism.bodies]
-    return Samples(time=time[keep], positions={b: values[f"{b}_position"] for b in bodies},
+    return Samples(time=time, positions={b: values[f"{b}_position"] for b in bodies},
                    velocities={b: values[f"{b}_velocity"] for b in bodies},
                    accelerations={b: values[f"{b}_acceleration"] for b in bodies},
                    forces={c.name: values[f"{c.name}_force"] for c in assembly.mechanism.connectors
                            if c.records_force})
+
+
+#: Steps at least per window where a load varies (a breech pulse): the step is limited to its length / this.
+STEPS_PER_LOAD_WINDOW = 40
+
+
+def segment_plan(mechanism: Mechanism, end_time: float, settings: SolverSettings) -> list[tuple[float, float, SolverSettings]]:
+    """``(start s, end s, settings)`` of each segment of a run: split at every shot and every jump of a
+    load (:attr:`Mechanism.breakpoints`); inside a load's window the adaptive ``max_step`` is at most the
+    window's length / :data:`STEPS_PER_LOAD_WINDOW`, so that no pulse is stepped over."""
+    cuts = [0.0] + [t for t in mechanism.breakpoints if t < end_time] + [float(end_time)]
+    plan = []
+    for t0, t1 in zip(cuts[:-1], cuts[1:]):
+        segment_settings = settings
+        for load in mechanism.loads:
+            for w0, w1 in load.windows:
+                if w0 < t1 and t0 < w1 and settings.adaptive:
+                    limit = (w1 - w0) / STEPS_PER_LOAD_WINDOW
+                    if limit < segment_settings.max_step:
+                        segment_settings = replace(segment_settings, max_step=limit)
+        plan.append((t0, t1, segment_settings))
+    return plan
+
+
+def _run_segments(assembly: Assembly, settings: SolverSettings, end_time: float,
+                  tracker: FinalityTracker | None) -> tuple[int, float, Samples]:
+    """Solve a scene with shots or pulses segment by segment (:func:`segment_plan`).
+
+    At each segment's start the shots firing then add their velocity jumps to the state; each segment
+    is one Exudyn solve from the previous one's end state.  Returns (steps, simulated end time s, samples).
+    """
+    mechanism, data = assembly.mechanism, assembly.mbs.systemData
+    run: dict = {"end_time": end_time}
+    segments, steps, simulated_end = [], 0, 0.0
+    for k, (t0, t1, segment_settings) in enumerate(segment_plan(mechanism, end_time, settings)):
+        if k:
+            q = np.array(data.GetODE2Coordinates(), dtype=float)
+            v = np.array(data.GetODE2Coordinates_t(), dtype=float)
+            for t_shot, body, jump in mechanism.impulses:
+                if t_shot == t0:
+                    v[assembly.coordinates[body]] += jump
+            for configuration in (exudyn.ConfigurationType.Initial, exudyn.ConfigurationType.Current):
+                data.SetODE2Coordinates(q.tolist(), configuration=configuration)
+                data.SetODE2Coordinates_t(v.tolist(), configuration=configuration)
+        accelerations = _initial_accelerations(assembly, t0)
+        n, simulated_end = _solve(assembly, segment_settings, t1, tracker, t0, run)
+        steps += n
+        segments.append(_read_segment(assembly, settings, t0, accelerations))
+        if tracker is not None and tracker.done:
+            break
+    return steps, simulated_end, _collect(assembly, simulated_end, settings, segments=segments)
 
 
 def _settings_after_stepped_over_contacts(mechanism: Mechanism, samples: Samples, settings: SolverSettings,
@@ -346,10 +429,14 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
         assembly = assemble(scene, settings.user_functions, mechanism)
         t_assembled = _time.perf_counter()
         try:
-            initial_accelerations = _initial_accelerations(assembly)
-            steps, simulated_end = _solve(assembly, settings, float(end_time), tracker)
-            t_solved = _time.perf_counter()
-            samples = _collect(assembly, simulated_end, settings, initial_accelerations)
+            if mechanism.breakpoints or mechanism.loads:
+                steps, simulated_end, samples = _run_segments(assembly, settings, float(end_time), tracker)
+                t_solved = _time.perf_counter()
+            else:
+                initial_accelerations = _initial_accelerations(assembly)
+                steps, simulated_end = _solve(assembly, settings, float(end_time), tracker)
+                t_solved = _time.perf_counter()
+                samples = _collect(assembly, simulated_end, settings, initial_accelerations)
         except _StepSizeStalled as stalled:
             retry = _absolute_tolerance_settings(settings) if settings.adaptive else None
             if retry is None:
@@ -377,8 +464,15 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
             raise SimulationError(f"post-processing produced a non-finite {name.replace('_', ' ')}")
     energy_error = (result.kinetic_energy_history + result.stored_energy_history
                     + sum(result.dissipated_energy_history.values()) - mechanism.initial_energy())
-    stability.check_energy_balance(scene, samples.time, energy_error, f"Exudyn {settings.label()}")
-    if stopped and largest_energy_rise(result.kinetic_energy_history + result.stored_energy_history) > ENERGY_SLACK:
+    mechanical = result.kinetic_energy_history + result.stored_energy_history
+    scale = None
+    if result.work_histories:
+        work = result.work_history
+        energy_error = energy_error - work
+        mechanical = mechanical - work  # what never increases once the inputs are counted
+        scale = mechanism.initial_energy() + float(np.max(np.abs(work)))
+    stability.check_energy_balance(scene, samples.time, energy_error, f"Exudyn {settings.label()}", scale)
+    if stopped and largest_energy_rise(mechanical) > ENERGY_SLACK:
         # the solution's energy rose by more than the bounds' slack: do not trust the early stop
         result = simulate(scene, end_time, settings, impact_threshold=impact_threshold)
         result.stop_reason = STOP_ENERGY_CHECK
@@ -427,6 +521,7 @@ def _result(scene: Scene, settings: SolverSettings, mechanism: Mechanism, sample
     energies = metrics.energies
     element_of = {body.name: body.element or body.name for body in mechanism.bodies}
     element_of.update({c.name: c.element for c in mechanism.connectors})
+    element_of.update({load.name: load.element for load in mechanism.loads})
     return Result(
         scene=scene, settings=settings, end_time=float(samples.time[-1]), time=samples.time,
         positions=samples.positions, velocities=samples.velocities, accelerations=samples.accelerations,
@@ -439,7 +534,8 @@ def _result(scene: Scene, settings: SolverSettings, mechanism: Mechanism, sample
         dissipated_energy={name: float(history[-1]) for name, history in energies.dissipated.items()},
         peak_support_force=metrics.peak_support_force, time_of_peak_support_force=metrics.time_of_peak_support_force,
         max_velocities=dict(metrics.max_velocity), dissipated_energy_history=energies.dissipated,
-        stored_energy_histories=energies.stored, kinetic_energy_histories=energies.kinetic, element_of=element_of)
+        stored_energy_histories=energies.stored, kinetic_energy_histories=energies.kinetic, element_of=element_of,
+        work_histories=energies.work, shots=metrics.shots)
 
 
 def _drop_unproven(result: Result, final: tuple[str, ...]) -> None:

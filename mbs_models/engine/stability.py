@@ -334,13 +334,15 @@ def check_settings(scene: Scene, settings: SolverSettings, end_time: float) -> N
                       AccuracyWarning, stacklevel=3)
 
 
-def check_energy_balance(scene: Scene, time: np.ndarray, error: np.ndarray, solver_label: str) -> None:
+def check_energy_balance(scene: Scene, time: np.ndarray, error: np.ndarray, solver_label: str,
+                         energy_scale: float | None = None) -> None:
     """Refuse a solve whose energy balance (``error`` in J at ``time``) is off by more than
-    :data:`ENERGY_FAILURE` of the initial energy: its numbers would be garbage.  Warn (AccuracyWarning)
+    :data:`ENERGY_FAILURE` of the initial energy (``energy_scale`` J where external inputs add energy:
+    the initial energy plus the largest work done): its numbers would be garbage.  Warn (AccuracyWarning)
     above :data:`ENERGY_WARNING`."""
     from ..errors import SimulationError
 
-    energy = max(initial_energy(scene), 1e-300)
+    energy = max(initial_energy(scene) if energy_scale is None else energy_scale, 1e-300)
     relative = np.abs(np.asarray(error, dtype=float)) / energy
     k = int(np.argmax(relative))
     worst = float(relative[k])

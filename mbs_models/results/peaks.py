@@ -38,8 +38,14 @@ class HermiteTrajectory:
         """Values at ``t_i + f h_i`` for every interval i and fraction f: shape (intervals, fractions)."""
         t0, t1 = self.time[:-1, None], self.time[1:, None]
         f = np.asarray(fractions, dtype=float)[None, :]
-        return hermite(t0, t1, self.y[:-1, None], self.y[1:, None], self.dy[:-1, None], self.dy[1:, None],
-                       t0 + f * (t1 - t0))
+        if np.all(t1 > t0):
+            return hermite(t0, t1, self.y[:-1, None], self.y[1:, None], self.dy[:-1, None], self.dy[1:, None],
+                           t0 + f * (t1 - t0))
+        # zero-length intervals (a jump at a segment boundary, e.g. a shot): the value before the jump
+        with np.errstate(invalid="ignore", divide="ignore"):
+            values = hermite(t0, t1, self.y[:-1, None], self.y[1:, None], self.dy[:-1, None], self.dy[1:, None],
+                             t0 + f * (t1 - t0))
+        return np.where(t1 > t0, values, self.y[:-1, None])
 
 
 def runs_of_true(flags: np.ndarray) -> list[tuple[int, int]]:

@@ -96,11 +96,14 @@ def find_impacts(mechanism, connector, s: Samples, force: np.ndarray, interp: In
 
 @dataclass
 class Energies:
-    """Energy histories at the samples (J): kinetic per body, stored and dissipated per connector."""
+    """Energy histories at the samples (J): kinetic per body, stored and dissipated per connector, and the
+    work done on the mechanism by each external input (a load by its name, the shots of a burst by
+    their element's name).  ``kinetic + stored + dissipated - work`` stays the initial energy."""
 
     kinetic: dict[str, np.ndarray]
     stored: dict[str, np.ndarray]
     dissipated: dict[str, np.ndarray]
+    work: dict[str, np.ndarray] = field(default_factory=dict)
 
     @property
     def kinetic_total(self) -> np.ndarray:
@@ -145,7 +148,20 @@ def energies(mechanism, s: Samples, interp: Interpolant) -> Energies:
             dissipated[connector.name] = connector.dissipated_energy(
                 quadrature, mechanism.relative(connector, x_nodes), mechanism.relative(connector, v_nodes),
                 nodes_t, samples)
-    return Energies(kinetic, stored, dissipated)
+    work: dict[str, np.ndarray] = {}
+    for load in mechanism.loads:
+        work[load.name] = load.work(quadrature, s.positions[load.body], v_nodes[load.body], nodes_t)
+    for t_shot, body, _ in mechanism.impulses:
+        jump = np.flatnonzero((t[:-1] == t_shot) & (t[1:] == t_shot))
+        if not len(jump):
+            continue  # after the end of the window (an early stop)
+        j = int(jump[0]) + 1  # the sample after the velocity jump
+        mass = mechanism.bodies[mechanism.body_index[body]].mass
+        gain = 0.5 * mass * (s.velocities[body][j] ** 2 - s.velocities[body][j - 1] ** 2)
+        name = mechanism.impulse_element[(t_shot, body)]
+        history = work.setdefault(name, np.zeros_like(t))
+        history[j:] += gain
+    return Energies(kinetic, stored, dissipated, work)
 
 
 @dataclass
@@ -160,6 +176,7 @@ class Metrics:
     peak_support_force: float | None = None
     time_of_peak_support_force: float | None = None
     energies: Energies | None = None
+    shots: list[dict] | None = None
 
 
 def support_force_samples(mechanism, s: Samples) -> np.ndarray:
@@ -219,7 +236,54 @@ def analyse(mechanism, s: Samples, impact_threshold: float, wanted: tuple[str, .
         metrics.peak_support_force, metrics.time_of_peak_support_force = _refined_support_peak(
             mechanism, s, interp, metrics.support_force)
     metrics.energies = energies(mechanism, s, interp)
+    metrics.shots = shot_outputs(mechanism, s, interp)
     return metrics
+
+
+#: A barrel within this distance (m) of its position before the first shot is "in battery".
+BATTERY_TOLERANCE = 1.0e-3
+
+
+def shot_outputs(mechanism, s: Samples, interp: Interpolant) -> list[dict] | None:
+    """Per shot of a ``[burst]`` (None without one), in the window simulated.
+
+    Each entry: ``shot`` (1, 2, ...), ``time`` (s) it fires; ``max_barrel_displacement`` (m) and its
+    time, refined, between this shot and the next (or the end); ``position_at_next_shot`` (m) and
+    ``velocity_at_next_shot`` (m/s): the barrel's state just before the next shot fires, and
+    ``in_battery_at_next_shot`` (within :data:`BATTERY_TOLERANCE` of its position before the first
+    shot), None for the last shot; ``time_to_battery`` (s after the shot): the first return within
+    :data:`BATTERY_TOLERANCE` of battery after the shot's maximum displacement (None if it does not
+    return before the next shot or the end).
+    """
+    burst = getattr(mechanism.scene, "burst", None)
+    if burst is None:
+        return None
+    t, x, v = s.time, s.positions[BARREL], s.velocities[BARREL]
+    battery = float(x[0])
+    shots = burst.shot_times
+    out = []
+    for k, t_shot in enumerate(shots):
+        if t_shot > t[-1]:
+            break
+        lo = int(np.searchsorted(t, t_shot, side="right")) - 1  # the sample after the shot's jump
+        following = shots[k + 1] if k + 1 < len(shots) and shots[k + 1] <= t[-1] else None
+        hi = int(np.searchsorted(t, following, side="left")) if following is not None else len(t) - 1
+        window = slice(lo, hi + 1)
+        x_max, t_max = refine_maximum(t[window], x[window], v[window])
+        entry = {"shot": k + 1, "time": float(t_shot), "max_barrel_displacement": float(x_max),
+                 "time_of_max_barrel_displacement": float(t_max),
+                 "position_at_next_shot": None if following is None else float(x[hi]),
+                 "velocity_at_next_shot": None if following is None else float(v[hi]),
+                 "in_battery_at_next_shot": None if following is None else bool(abs(x[hi] - battery) <= BATTERY_TOLERANCE),
+                 "time_to_battery": None}
+        back = np.flatnonzero((t[window] > t_max) & (np.abs(x[window] - battery) <= BATTERY_TOLERANCE))
+        if len(back):
+            j = lo + int(back[0])
+            crossing = refine_crossing(lambda times: np.abs(interp.x[BARREL](times) - battery) <= BATTERY_TOLERANCE,
+                                       max(t[j - 1], t_max), t[j])
+            entry["time_to_battery"] = float(crossing - t_shot)
+        out.append(entry)
+    return out
 
 
 def _contact_output(mechanism, connector, s: Samples, interp: Interpolant, impact_threshold: float) -> ContactOutput:

@@ -113,6 +113,8 @@ class Result:
     stored_energy_histories: dict[str, np.ndarray] = field(repr=False, default_factory=dict)
     kinetic_energy_histories: dict[str, np.ndarray] = field(repr=False, default_factory=dict)
     element_of: dict[str, str] = field(repr=False, default_factory=dict)
+    work_histories: dict[str, np.ndarray] = field(repr=False, default_factory=dict)
+    shots: list[dict[str, Any]] | None = None
     wall_time: float = 0.0
     timings: dict[str, float] = field(default_factory=dict)
     steps: int = 0
@@ -186,19 +188,29 @@ class Result:
         return float(sum(self.dissipated_energy.values()))
 
     def energy_error(self) -> np.ndarray:
-        """Energy balance residual over time, in J: kinetic + stored + dissipated - initial energy.
+        """Energy balance residual over time, in J: kinetic + stored + dissipated - work - initial energy.
 
         The initial energy is the kinetic energy at t = 0 plus the stored energy of an initial
         interference.  Zero for an exact solution; its size measures the integration (and quadrature) error.
         """
         dissipated = sum(self.dissipated_energy_history.values())
         initial = self.kinetic_energy_history[0] + self.stored_energy_history[0]
-        return self.kinetic_energy_history + self.stored_energy_history + dissipated - initial
+        error = self.kinetic_energy_history + self.stored_energy_history + dissipated - initial
+        if self.work_histories:
+            error = error - self.work_history
+        return error
+
+    @property
+    def work_history(self) -> np.ndarray:
+        """Work (J) done on the mechanism by every external input (breech force, shots, gravity) since t = 0."""
+        return _sum(self.work_histories.values(), self.time)
 
     def energy(self) -> dict[str, dict[str, float]]:
         """Per element at the end time, J: ``{element: {"kinetic": ..., "stored": ..., "dissipated": ...}}``.
 
-        Their sum over elements and kinds is the initial energy (up to :meth:`energy_error`).
+        Elements with an external input (the firing's breech force or shots, gravity) also have ``"work"``,
+        the work done on the mechanism.  Kinetic + stored + dissipated - work, summed over the elements,
+        is the initial energy (up to :meth:`energy_error`).
         """
         out: dict[str, dict[str, float]] = {}
         for kind, histories in (("kinetic", self.kinetic_energy_histories), ("stored", self.stored_energy_histories),
@@ -207,6 +219,10 @@ class Result:
                 element = self.element_of.get(name, name)
                 entry = out.setdefault(element, {"kinetic": 0.0, "stored": 0.0, "dissipated": 0.0})
                 entry[kind] += float(history[-1])
+        for name, history in self.work_histories.items():
+            element = self.element_of.get(name, name)
+            entry = out.setdefault(element, {"kinetic": 0.0, "stored": 0.0, "dissipated": 0.0})
+            entry["work"] = entry.get("work", 0.0) + float(history[-1])
         return out
 
     # ------------------------------------------------------------------ per element
@@ -262,9 +278,25 @@ class Result:
             "stops": self.stops(),
             "dissipated_energy": dict(self.dissipated_energy),
             "energy": self.energy(),
+            **self._firing_metrics(),
             "steps": self.steps,
             "wall_time": self.wall_time,
         }
+
+    def _firing_metrics(self) -> dict[str, Any]:
+        """``pulse_impulse`` (N s, with a breech-force pulse), ``shots`` (with a burst), ``work`` (J, with
+        external inputs): only for scenes that have them (version-1 keys stay as they were)."""
+        out: dict[str, Any] = {}
+        firing = getattr(self.scene, "firing", None)
+        pulse = getattr(firing, "pulse", None)
+        if pulse is not None:
+            scale = firing.momentum / pulse.impulse if pulse.scale_to_momentum else 1.0
+            out["pulse_impulse"] = scale * pulse.impulse
+        if self.shots is not None:
+            out["shots"] = [dict(shot) for shot in self.shots]
+        if self.work_histories:
+            out["work"] = {name: float(history[-1]) for name, history in self.work_histories.items()}
+        return out
 
     def summary(self) -> str:
         """A few human-readable lines."""
@@ -303,8 +335,20 @@ class Result:
             text = not_final if peak is None else (f"{peak / 1e3:.3f} kN" + (
                 f", {len(stop['impacts'])} impacts" if stop["impacts"] is not None else ""))
             lines.append(f"  {stop['name'].replace('_', ' '):24s} {text}")
+        firing = self._firing_metrics()
+        if "pulse_impulse" in firing:
+            lines.append(f"  breech pulse impulse     {firing['pulse_impulse']:.1f} N s per shot")
+        for shot in firing.get("shots", []):
+            back = "never back in battery" if shot["time_to_battery"] is None else \
+                f"in battery {shot['time_to_battery']:.3f} s after it"
+            state = "" if shot["in_battery_at_next_shot"] is None else \
+                (", in battery at the next shot" if shot["in_battery_at_next_shot"] else
+                 f", OUT of battery at the next shot (x = {shot['position_at_next_shot'] * 1e3:.1f} mm)")
+            lines.append(f"  shot {shot['shot']:<3d} at {shot['time']:7.3f} s  max {shot['max_barrel_displacement']:.6f} m, "
+                         f"{back}{state}")
+        supplied = self.kinetic_energy_history[0] + self.stored_energy_history[0] + sum(firing.get("work", {}).values())
         lines.append(f"  energy dissipated        {self.total_dissipated_energy:.2f} J of "
-                     f"{self.kinetic_energy_history[0] + self.stored_energy_history[0]:.2f} J")
+                     f"{supplied:.2f} J" + (" (with the work of the inputs)" if "work" in firing else ""))
         lines.append(f"  wall time                {self.wall_time * 1e3:.1f} ms ({self.steps} steps)")
         return "\n".join(lines)
 

@@ -163,8 +163,8 @@ def test_solver_that_stops_early_with_success_is_a_simulation_error(monkeypatch,
 
     original = simulation.exudyn_simulation_settings
 
-    def stopping_halfway(settings, end_time):
-        ss = original(settings, end_time)
+    def stopping_halfway(settings, end_time, start_time=0.0):
+        ss = original(settings, end_time, start_time)
         ss.timeIntegration.endTime = 0.5 * end_time
         return ss
 
