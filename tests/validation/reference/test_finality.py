@@ -123,8 +123,9 @@ def _check(scene, requested):
         assert len(early.segments) <= len(full.segments)
         for a, b in zip(early.segments[:-1], full.segments):  # the same segments before the stop
             assert (a.t0, a.t1, a.mode) == (b.t0, b.t1, b.mode)
-    else:
-        assert early.stop_reason == "end_time" and early.end_time == END
+    else:  # a load acting for ever (gravity along a cradle) leaves the scene without a bound
+        assert early.stop_reason == ("end_time_no_energy_bound" if full.model.loads else "end_time")
+        assert early.end_time == END
     _assert_same_as_full(early, full)
     return early
 
@@ -143,13 +144,18 @@ def test_early_stopped_reference_gives_the_full_runs_metrics(key, requested):
 @pytest.mark.parametrize("key", [*NEW, *EVERY])
 def test_early_stop_with_several_absorbers_every_element_and_every_law(key, requested, new_scenes):
     early = _check(new_scenes[key], requested)
-    assert early.stop_reason == "metrics_final", (key, requested)
+    expected = "end_time_no_energy_bound" if early.model.loads else "metrics_final"  # a load for ever: no bound
+    assert early.stop_reason == expected, (key, requested)
 
 
 @pytest.mark.parametrize("key", ["two-absorbers-every-element", "ii-gonthier", "i-kelvin-voigt",
                                  "ii-exact-every-element-hertz"])
 def test_the_bounds_bound_the_future_with_several_absorbers_every_element_and_every_law(key, new_scenes):
-    assert_bounds_hold(_full(new_scenes[key]), END)
+    result = _full(new_scenes[key])
+    if result.model.loads:  # a load acting for ever may add energy: no bound is claimed, none is used
+        assert not finality.Finality(result.model, ALL, 1000.0).enabled
+        return
+    assert_bounds_hold(result, END)
 
 
 @pytest.mark.slow

@@ -55,8 +55,8 @@ class CoulombFriction(Connector):
         the dissipated power ``F d'``."""
         if state == STICK:
             return Equations("""
-                {F} = {fb}
-                {P} = {F} * ({vb} - {va})""", constraint=True)
+                {F} = {fb} + 0.0
+                {P} = {F} * ({vb} - {va})""", constraint=True)  # + 0.0: a copy (numpy rows are updated in place)
         return Equations("""
             {F} = {f}
             {P} = {f} * ({vb} - {va})""", dict(f=self.force if state == SLIP_FORWARD else -self.force))
@@ -91,7 +91,12 @@ class CoulombFriction(Connector):
         """``v = 0`` while slipping; ``F = +mu N`` and ``F = -mu N`` while stuck."""
         rate_of = self.rate_of
         if state != STICK:
-            return [("v", lambda t, y: rate_of(y), state == SLIP_FORWARD, rate_of(restart.dy),
+            # a slide that starts on v = 0 (out of stick, or from rest) watches v - v(start): the round-off left
+            # in v (either sign, ~1e-17 m/s) is not a crossing; the acceleration then grows from 0 as the force
+            # that broke the stick keeps growing
+            start = restart.s[self.ib + 1] - restart.s[self.ia + 1]
+            offset = start if abs(start) <= restart.velocity_noise else 0.0
+            return [("v", lambda t, y: rate_of(y) - offset, state == SLIP_FORWARD, rate_of(restart.dy),
                      restart.velocity_noise)]
         held = restart.force_function(self)
         limit = self.force
