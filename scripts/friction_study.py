@@ -109,7 +109,8 @@ def build(law, friction, force, k=0.0, c=0.0, v_reg=1e-4, k_stick=1e9):
     elif law == "tanh":
         from exudyn.advancedUtilities import CreateSymbolicUserFunction
         esym = exudyn.symbolic
-        index = mbs.AddObject(ObjectConnectorCoordinateSpringDamper(markerNumbers=[ground, barrel], visualization=HIDDEN))
+        index = mbs.AddObject(ObjectConnectorCoordinateSpringDamper(markerNumbers=[ground, barrel],
+                                                                    visualization=HIDDEN))
 
         def user_function(mbs, t, item, d, v, stiffness, damping, offset):
             return friction * esym.tanh(v / v_reg)

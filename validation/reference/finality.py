@@ -3,9 +3,10 @@
 Written from the model's connectors (:mod:`validation.reference.model`), independently of the engine's
 early stop.  For a dissipative scene (no connector injects energy: only the paper's
 ``literal_lambda_sign`` reading does; and no external load, which acts for ever and may add energy: gravity
-along an inclined cradle -- such a scene has no bound and runs to its end) the mechanical energy ``E = sum m v^2/2 + sum U`` (J) never
-increases: its rate is minus the dissipated powers, each >= 0.  So with ``E`` now, at every later time
-(SI units; every bound is used with ``E (1 + ENERGY_SLACK)`` against the integration error):
+along an inclined cradle -- such a scene has no bound and runs to its end) the mechanical energy
+``E = sum m v^2/2 + sum U`` (J) never increases: its rate is minus the dissipated powers, each >= 0.  So with
+``E`` now, at every later time (SI units; every bound is used with ``E (1 + ENERGY_SLACK)`` against the
+integration error):
 
 * **positions**: the linear springs' energy ``q^T K q / 2 <= E`` (``q`` the body positions, ``K`` positive
   semi-definite, assembled from every connector's ``linear_stiffness``), so a combination ``c.q`` is at
@@ -161,7 +162,8 @@ class Finality:
         self.model = model
         self.requested = check_names(requested)
         self.impact_threshold = float(impact_threshold)
-        self.enabled = not any(c.injects_energy for c in model.connectors) and not model.loads  # a load for ever: no bound
+        # a load acting for ever (gravity) may add energy: no bound
+        self.enabled = not any(c.injects_energy for c in model.connectors) and not model.loads
         self.energy_bounds = EnergyBounds(model)
         contacts = [c.index for c in model.contacts]
         self.items = {
