@@ -209,6 +209,14 @@ class Firing(Table):
             momentum += self.charge_mass * self.gas_velocity
         return momentum
 
+    @property
+    def shot_momentum(self) -> float:
+        """The momentum (kg m/s) one shot gives the barrel: :attr:`momentum` for an impulse; the pulse's
+        impulse (scaled to the momentum if asked) with a pulse."""
+        if self.pulse is None or self.pulse.scale_to_momentum:
+            return self.momentum
+        return self.pulse.impulse
+
     def initial_velocity(self, moving_mass: float) -> float:
         """v0 (m/s) of a recoiling mass ``moving_mass`` (kg): momentum / mass; 0 with a pulse (at rest)."""
         if self.pulse is not None:

@@ -153,6 +153,10 @@ def estimate_contacts(scene: Scene | Mechanism) -> dict[str, ContactEstimate]:
     out = {}
     energy = mechanism.initial_energy()
     v0 = mechanism.scene.initial_velocity
+    firing = getattr(mechanism.scene, "firing", None)
+    if firing is not None and firing.pulse is not None:  # the barrel starts at rest: the pulse's momentum
+        v0 = firing.shot_momentum / mechanism.scene.barrel.mass
+        energy += 0.5 * mechanism.scene.barrel.mass * v0 ** 2
     for contact in mechanism.contacts:
         n, k = contact.exponent, contact.contact_stiffness
         m_red = _reduced_mass(mechanism, contact)

@@ -290,8 +290,7 @@ class Result:
         firing = getattr(self.scene, "firing", None)
         pulse = getattr(firing, "pulse", None)
         if pulse is not None:
-            scale = firing.momentum / pulse.impulse if pulse.scale_to_momentum else 1.0
-            out["pulse_impulse"] = scale * pulse.impulse
+            out["pulse_impulse"] = firing.shot_momentum
         if self.shots is not None:
             out["shots"] = [dict(shot) for shot in self.shots]
         if self.work_histories:

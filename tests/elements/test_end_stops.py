@@ -186,7 +186,7 @@ def test_the_reference_names_the_stops_after_their_tables(every_element):
                            "rear_contact", "recoil_stop", "battery_stop")
     assert [c.name for c in model.dissipating] == ["recoil_damper", "front_damper", "front_contact", "rear_damper",
                                                    "rear_contact", "recoil_stop", "battery_stop"]
-    assert model.n_states == 2 * 3 + 7
+    assert model.n_states == 2 * 3 + 7 + len(model.work_slot)  # then the work of the inputs (a burst's shots)
 
 
 #: model (ii), m = 100 kg, with a hard recoil stop and a Kelvin-Voigt buffer 20 mm behind battery

@@ -275,3 +275,48 @@ def test_ten_shots_on_model_ii_stay_finite_and_balanced():
         work = result.energy()["burst"]["work"]
         bound = 1e-3 if accuracy == "draft" else 5e-6
         assert np.max(np.abs(result.energy_error())) < bound * (result.kinetic_energy_history[0] + work)
+
+
+# ------------------------------------------------------------------ the engine against the reference
+def _shipped(name: str) -> Scene:
+    from mbs_models.scenes import scene_path
+    return load_scene(scene_path(name))
+
+
+def _short_pulse_on_model_ii() -> Scene:
+    """A hard case: model (ii) at gap 0 driven by a 0.1 ms pulse, ~100x shorter than its contact (~10 ms)."""
+    from mbs_models import model_ii
+    firing = Firing(projectile_mass=6.86, muzzle_velocity=564.0,
+                    pulse=Pulse(times=(0.0, 2e-5, 1e-4), forces=(0.0, 1.0, 0.0), scale_to_momentum=True))
+    return model_ii(1000.0, 0.0).with_changes(firing=firing, name="model (ii), 0.1 ms pulse")
+
+
+def _ten_shots() -> Scene:
+    from mbs_models import model_ii
+    return model_ii(1000.0, 0.0).with_changes(burst=Burst(shots=10, interval=0.3), name="model (ii), 10 shots")
+
+
+CASES = {"breech_pulse": lambda: _shipped("breech_pulse"), "burst": lambda: _shipped("burst"),
+         "short_pulse": _short_pulse_on_model_ii, "ten_shots": _ten_shots}
+
+
+@pytest.mark.parametrize("accuracy", PRESETS)
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_the_engine_agrees_with_the_reference(agrees_with_reference, case, accuracy):
+    """The README's guarantee at every preset: pulses (one 100x shorter than the contact) and bursts."""
+    agrees_with_reference(CASES[case](), 3.5 if case == "ten_shots" else 2.0, accuracy)
+
+
+@pytest.mark.parametrize("case", ["burst", "ten_shots"])
+def test_the_shots_agree_with_the_reference(case):
+    from validation.reference import solve_reference
+    scene = CASES[case]()
+    end = 3.5 if case == "ten_shots" else 2.0
+    engine, reference = simulate(scene, end, "reference"), solve_reference(scene, end)
+    assert len(engine.shots) == len(reference.shots)
+    for ours, theirs in zip(engine.shots, reference.shots):
+        assert ours["max_barrel_displacement"] == pytest.approx(theirs["max_barrel_displacement"], rel=1e-7)
+        assert ours["in_battery_at_next_shot"] == theirs["in_battery_at_next_shot"]
+        if theirs["position_at_next_shot"] is not None:
+            assert ours["position_at_next_shot"] == pytest.approx(theirs["position_at_next_shot"], abs=1e-8)
+    assert engine.energy()["burst"]["work"] == pytest.approx(reference.work["burst"], rel=1e-7)

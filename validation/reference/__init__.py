@@ -8,6 +8,11 @@ checks what it imports against an allow-list.  SI units throughout (m, s, kg, N,
 * :mod:`.terms` -- one module per physical effect (bodies, forces, energies, switching surfaces, bounds);
   :mod:`.model`, :mod:`.assembly`, :mod:`.switching`, :mod:`.solver`, :mod:`.result` and
   :mod:`.finality` (the early stop) run them without naming any effect;
+* external inputs (:mod:`.model`): a :class:`~.model.Load` ``L(t)`` on one body (``builder.add_load``:
+  :class:`~.model.ConstantLoad`, :class:`~.model.PiecewiseLinearLoad` -- the breech force of ``[firing.pulse]``)
+  and :class:`~.model.Impulse` velocity jumps (the later shots of a ``[burst]``); their breakpoints and
+  times split the solve, their work is in the energy balance (``ReferenceResult.work_history``); the
+  result's ``shots`` gives the per-shot outputs, ``pulse_impulse`` the pulse's impulse;
 * :mod:`.closed_form` -- oracles: :func:`simplified_max_displacement`, :func:`hunt_crossley_restitution`,
   :func:`restitution_factor`, :func:`exact_restitution_factor`, :func:`achieved_restitution`,
   :func:`kelvin_voigt_restitution`.

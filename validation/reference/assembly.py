@@ -8,12 +8,13 @@ error: the reference would silently leave an effect out.
 
 from __future__ import annotations
 
-from .model import BARREL, AbsorberRole, Body, Connector, Load, Model, ReferenceModelError
+from .model import BARREL, AbsorberRole, Body, Connector, Impulse, Load, Model, ReferenceModelError
 from .terms import TERMS
 
 
 class ModelBuilder:
-    """What the terms add while a scene is read: bodies, connectors, absorbers and stops (by name), loads."""
+    """What the terms add while a scene is read: bodies, connectors, absorbers and stops (by name), external
+    loads and velocity jumps, and the shot times of a burst (None unless a term sets them)."""
 
     def __init__(self, scene):
         self.scene = scene
@@ -22,6 +23,8 @@ class ModelBuilder:
         self.absorbers: list[AbsorberRole] = []
         self.stops: list[str] = []
         self.loads: list[Load] = []
+        self.impulses: list[Impulse] = []
+        self.shot_times: tuple[float, ...] | None = None
 
     def add_body(self, body: Body) -> None:
         self.bodies.append(body)
@@ -35,14 +38,23 @@ class ModelBuilder:
     def add_stop(self, name: str) -> None:
         self.stops.append(name)
 
-    def add_load(self, name: str, body: str, force: float) -> None:
-        """A constant external force ``force`` (N) on ``body`` (:class:`~validation.reference.model.Load`)."""
-        self.loads.append(Load(name, body, float(force)))
+    def add_load(self, load: Load) -> None:
+        """An external force L(t) on one body (:class:`~validation.reference.model.Load`)."""
+        self.loads.append(load)
+
+    def add_impulse(self, impulse: Impulse) -> None:
+        """Velocity jumps of one body at given times (:class:`~validation.reference.model.Impulse`)."""
+        self.impulses.append(impulse)
+
+    def set_shot_times(self, times) -> None:
+        """The times (s) the shots of a burst fire, from 0 (the per-shot outputs and time events)."""
+        self.shot_times = tuple(float(t) for t in times)
 
     def model(self) -> Model:
         """The model: the barrel first, then the other bodies in the order they were added."""
         bodies = sorted(self.bodies, key=lambda b: b.name != BARREL)
-        return Model(getattr(self.scene, "name", ""), bodies, self.connectors, self.absorbers, self.stops, self.loads)
+        return Model(getattr(self.scene, "name", ""), bodies, self.connectors, self.absorbers, self.stops,
+                     self.loads, self.impulses, self.shot_times)
 
 
 def table_name(key: str) -> str:

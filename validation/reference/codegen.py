@@ -7,7 +7,6 @@ joins them, for one :class:`~validation.reference.model.Mode`, into one function
 
     x0, v0, x1, v1, _, _, _ = y.tolist()       # positions and velocities of the bodies
     f0 = f1 = fg = 0.0                         # forces on the bodies and on the ground
-    f0 += 27468.0                              # external loads (gravity), on their body only
     <connector 0: sets F0 (and P0)>;  fg += F0;  f0 -= F0      # F pushes b to -x, a to +x
     ...                                        # constraints (a sliding contact) last
     return array([v0, f0 / M, v1, f1 / m, P1, P2, P3])
@@ -17,6 +16,12 @@ Kinds: ``"rhs"`` (Python floats; ``dy/dt``, inf where the arithmetic overflows, 
 accelerations and the support force ``fg`` = S; ``omit`` leaves one connector out).  The same source
 serves all three: only ``copysign`` differs (``math`` or ``numpy``).  Constants are written with
 ``repr`` (exact).  ``source(...)`` shows the code of a mode.
+
+A model with external loads (:class:`~validation.reference.model.Load`) adds, before the connectors
+(a sliding contact's constraint force sees them), ``L_k = <the load's piece in the mode, from t>`` and
+``f_i += L_k`` (nothing goes to the ground), and to ``dy/dt`` the work rates ``L_k v_i``; its
+``evaluate`` takes the time as well: ``evaluate(y, t)``.  A model without loads gets exactly the code
+above.
 """
 
 from __future__ import annotations
@@ -45,8 +50,17 @@ def source(model, mode, kind: str, omit: int | None = None) -> str:
     names = [n for i in range(nb) for n in (f"x{i}", f"v{i}")] + ["_"] * (model.n_states - 2 * nb)
     unpack = "y" if kind == "array" else "y.tolist()"
     body = [f"{', '.join(names)}, = {unpack}", " = ".join([f"f{i}" for i in range(nb)] + ["fg", "0.0"])]
-    for load, (i, force) in zip(model.loads, model.load_forces):  # external loads: on their body only
-        body += [f"# load {load.name}", f"f{i} += {force!r}"]
+    works = []
+    for k, load in enumerate(model.loads):
+        i = model.body_index[load.body]
+        code = load.equations(mode.loads[k]) if mode.loads else f"{{L}} = load{k}(t)"
+        if code is None:
+            works.append("0.0")
+            continue
+        body += ([f"# load {load.name}" + (f": piece {mode.loads[k]!r}" if mode.loads else "")]
+                 + [line.strip() for line in code.format(L=f"L{k}").strip().splitlines()] + [f"f{i} += L{k}"])
+        works.append(f"L{k} * v{i}")
+    works += ["0.0"] * len(model.impulses)
     blocks, late = [], []
     forces, powers = {}, {}
     for j, (c, state) in enumerate(zip(model.connectors, mode.states)):
@@ -68,19 +82,21 @@ def source(model, mode, kind: str, omit: int | None = None) -> str:
     accelerations = [f"f{i} / {model.masses[i]!r}" for i in range(nb)]
     if kind == "rhs":
         derivative = [x for i in range(nb) for x in (f"v{i}", accelerations[i])]
-        derivative += [powers.get(c.index, "0.0") for c in model.dissipating]
+        derivative += [powers.get(c.index, "0.0") for c in model.dissipating] + works
         body.append(f"return array([{', '.join(derivative)}])")
         inner = "\n".join("        " + line for line in body)
         return (f"def rhs(t, y):\n    try:\n{inner}\n    except OverflowError:\n"
                 f"        return full({model.n_states}, inf)\n")
     all_forces = [forces.get(j, "0.0") for j in range(len(model.connectors))]
     body.append(f"return [{', '.join(all_forces)}], [{', '.join(accelerations)}], fg")
-    return "def evaluate(y):\n" + "\n".join("    " + line for line in body) + "\n"
+    signature = "y, t" if model.loads else "y"
+    return f"def evaluate({signature}):\n" + "\n".join("    " + line for line in body) + "\n"
 
 
 def compile_mode(model, mode, kind: str, omit: int | None = None):
     """The function of ``kind`` for ``mode`` (see the module docstring)."""
     namespace = dict(_NAMESPACES[kind])
+    namespace.update({f"load{k}": load.force for k, load in enumerate(model.loads)})
     text = source(model, mode, kind, omit)
     exec(compile(text, f"<reference {kind} of {mode!r}>", "exec"), namespace)  # noqa: S102 - our own source
     return namespace["rhs" if kind == "rhs" else "evaluate"]

@@ -2,11 +2,9 @@
 
 Written from the model's connectors (:mod:`validation.reference.model`), independently of the engine's
 early stop.  For a dissipative scene (no connector injects energy: only the paper's
-``literal_lambda_sign`` reading does; and no external load, which acts for ever and may add energy: gravity
-along an inclined cradle -- such a scene has no bound and runs to its end) the mechanical energy
-``E = sum m v^2/2 + sum U`` (J) never increases: its rate is minus the dissipated powers, each >= 0.  So with
-``E`` now, at every later time (SI units; every bound is used with ``E (1 + ENERGY_SLACK)`` against the
-integration error):
+``literal_lambda_sign`` reading does) the mechanical energy ``E = sum m v^2/2 + sum U`` (J) never
+increases: its rate is minus the dissipated powers, each >= 0.  So with ``E`` now, at every later time
+(SI units; every bound is used with ``E (1 + ENERGY_SLACK)`` against the integration error):
 
 * **positions**: the linear springs' energy ``q^T K q / 2 <= E`` (``q`` the body positions, ``K`` positive
   semi-definite, assembled from every connector's ``linear_stiffness``), so a combination ``c.q`` is at
@@ -20,6 +18,10 @@ integration error):
   energy ``m v^2/2 + sum U`` from increasing: ``|v| <= sqrt(2 E_own / m)``;
 * **forces**: each connector bounds its force from those (``Connector.force_bound``); the support force
   ``|S|`` by the sum of the bounds of the connectors touching the ground.
+
+External inputs (loads, shots) add energy: the bounds hold only once the last of them has acted
+(:attr:`Model.last_input_time`; the solver checks from then on), and not at all under a load that never
+ends (a constant load: :attr:`Finality.enabled` is False).  The maxima are observed over the whole run.
 
 A metric is final once its observed maximum (a lower bound of the true one: values of the solution at the
 solver's step points) reaches the bound of everything later: ``max_barrel_displacement`` (x of the barrel),
@@ -162,8 +164,8 @@ class Finality:
         self.model = model
         self.requested = check_names(requested)
         self.impact_threshold = float(impact_threshold)
-        # a load acting for ever (gravity) may add energy: no bound
-        self.enabled = not any(c.injects_energy for c in model.connectors) and not model.loads
+        self.enabled = (not any(c.injects_energy for c in model.connectors)
+                        and math.isfinite(model.last_input_time))
         self.energy_bounds = EnergyBounds(model)
         contacts = [c.index for c in model.contacts]
         self.items = {
@@ -193,7 +195,7 @@ class Finality:
         ts = np.asarray(sol.ts, dtype=float)
         ts = np.unique(np.concatenate(([t0], ts[(ts > t0) & (ts < t1)], [t1])))
         y = sol(ts)
-        evaluation = self.model.evaluate(mode, y)
+        evaluation = self.model.evaluate(mode, y, t=ts)
         connectors = self.model.connectors
         for item in self.observed:
             kind = item[0]

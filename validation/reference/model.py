@@ -5,12 +5,25 @@ the recoil direction, 0 at the start).  Every force is a :class:`Connector` betw
 ``b`` (bodies, or the ground :data:`GROUND`) with relative coordinate ``d = x_b - x_a`` (m) and rate
 ``d' = v_b - v_a`` (m/s); its force ``F`` (N) pushes ``b`` towards -x and ``a`` towards +x::
 
-    m_i x_i'' = sum_{connectors with a = i} F  -  sum_{connectors with b = i} F  +  sum_{loads on i} F_load
+    m_i x_i'' = sum_{connectors with a = i} F  -  sum_{connectors with b = i} F
     S         = sum_{connectors with a = ground} F  -  sum_{connectors with b = ground} F   (support force)
 
-State vector ``y``: ``[x_0, v_0, x_1, v_1, ..., D_0, D_1, ...]`` -- position (m) and velocity (m/s) of
-every body (the barrel first, then the absorbers in scene order), then the dissipated energy ``D_j`` (J)
-of every dissipating connector, ``dD_j/dt = F d' - dU_j/dt`` (W).
+State vector ``y``: ``[x_0, v_0, x_1, v_1, ..., D_0, D_1, ..., W_0, W_1, ...]`` -- position (m) and
+velocity (m/s) of every body (the barrel first, then the absorbers in scene order), then the dissipated
+energy ``D_j`` (J) of every dissipating connector, ``dD_j/dt = F d' - dU_j/dt`` (W), then the work
+``W_k`` (J) of every external input (:class:`Load`, :class:`Impulse`; none in the paper's scenes).
+
+**External inputs** act on one body and are not transmitted to the ground (no share of S):
+
+* a :class:`Load` is a force ``L(t)`` (N, a function of time alone, positive in the recoil direction)
+  added to its body's force: ``m_i x_i'' = ... + L(t)``; its work ``dW/dt = L(t) v_i`` (W).  Its
+  *breakpoints* (times where L or dL/dt jumps) are time events of the solver: every segment integrates
+  one smooth *piece* of the law, fixed in the segment's :class:`Mode` (``mode.loads``);
+* an :class:`Impulse` adds a velocity jump ``dv`` (m/s) to its body at given times (the shots of a burst):
+  the solver stops there, jumps the state and restarts; the work of a jump is
+  ``m ((v + dv)^2 - v^2) / 2`` (J).
+
+Energy balance: ``sum kinetic + sum U + sum D - sum W = E(0)``.
 
 What a connector does is written in the term modules (:mod:`validation.reference.terms`); this module
 only runs them:
@@ -28,6 +41,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from typing import Any, Callable
+
+import bisect
+import math
 
 import numpy as np
 
@@ -185,31 +201,182 @@ class Connector:
         return 0.0
 
 
+class Load:
+    """An external force ``L(t)`` (N, positive in the recoil direction) on ``body``, a function of time alone.
+
+    It is added to the body's force and not transmitted to the ground (no share of the support force);
+    its work is ``W(t) = integral_0^t L v_body dt`` (J).  Subclasses give the law:
+
+    * :meth:`force` -- L at times ``t`` (float or numpy array), right-continuous at a jump;
+    * :attr:`breakpoints` -- times (s) where L or dL/dt is discontinuous: segment boundaries of the solve;
+    * :meth:`piece` / :meth:`equations` -- the smooth law on ``[t, next breakpoint]`` as Python source for
+      :mod:`validation.reference.codegen` (``{L}`` from ``t``), None where L is 0 there;
+    * :attr:`last_input_time` -- time (s) after which L is 0 (inf if it never ends: the early stop then has
+      no energy bound); :meth:`impulse` -- ``integral L dt`` (N s) over an interval.
+    """
+
+    def __init__(self, name: str, body: str):
+        self.name, self.body = name, body
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}({self.name!r} on {self.body})"
+
+    def force(self, t):
+        """L (N) at ``t`` (s)."""
+        raise NotImplementedError
+
+    @property
+    def breakpoints(self) -> tuple[float, ...]:
+        return ()
+
+    def piece(self, t: float):
+        """Key (hashable) of the smooth piece of the law on ``[t, next breakpoint)``."""
+        return 0
+
+    def equations(self, piece) -> str | None:
+        """Source lines setting ``{L}`` (N) from ``t`` on ``piece``; None: L is 0 on it."""
+        raise NotImplementedError
+
+    @property
+    def last_input_time(self) -> float:
+        raise NotImplementedError
+
+    def impulse(self, t0: float = -math.inf, t1: float = math.inf) -> float:
+        raise NotImplementedError
+
+
+class ConstantLoad(Load):
+    """``L = value`` (N) at all times (gravity along an inclined cradle): no breakpoints, never ends (unless
+    0); its work is ``value (x(t) - x(0))``, minus the change of the potential ``-value x``."""
+
+    def __init__(self, name: str, body: str, value: float):
+        super().__init__(name, body)
+        self.value = float(value)
+
+    def force(self, t):
+        return self.value + 0.0 * np.asarray(t, dtype=float) if np.ndim(t) else self.value
+
+    def equations(self, piece) -> str | None:
+        return None if self.value == 0.0 else f"{{L}} = {self.value!r}"
+
+    @property
+    def last_input_time(self) -> float:
+        return math.inf if self.value != 0.0 else 0.0
+
+    def impulse(self, t0: float = -math.inf, t1: float = math.inf) -> float:
+        return self.value * (t1 - t0) if self.value != 0.0 else 0.0
+
+
+class PiecewiseLinearLoad(Load):
+    """``L(t)`` linear between consecutive ``points`` ``(t s, L N)`` (sorted by time; a repeated time is a
+    jump, from the first value to the last of that time), 0 before the first and after the last point.
+
+    Between consecutive distinct times ``T_i < T_(i+1)`` (piece ``i + 1``; piece 0 is before ``T_0``)::
+
+        L(t) = L_i + (L_(i+1) - L_i) (t - T_i) / (T_(i+1) - T_i)
+
+    with ``L_i`` the last value at ``T_i`` and ``L_(i+1)`` the first value at ``T_(i+1)``.  Every ``T_i``
+    is a breakpoint.  ``integral L dt`` over a piece is exact by the trapezoidal rule.
+    """
+
+    def __init__(self, name: str, body: str, points):
+        super().__init__(name, body)
+        points = [(float(t), float(f)) for t, f in points]
+        if len(points) < 2 or any(b[0] < a[0] for a, b in zip(points, points[1:])):
+            raise ReferenceModelError(f"load {name!r}: needs at least two points in time order")
+        self.points = points
+        self.times = tuple(sorted({t for t, _ in points}))
+        first = {}
+        last = {}
+        for t, f in points:
+            first.setdefault(t, f)
+            last[t] = f
+        #: per piece i (1 .. len(times) - 1): (start time, value at the start, slope N/s)
+        self._pieces = {}
+        for i in range(1, len(self.times)):
+            a, b = self.times[i - 1], self.times[i]
+            start, end = last[a], first[b]
+            self._pieces[i] = (a, start, (end - start) / (b - a), end, b)
+        tail = [self._pieces.get(i, (0.0, 0.0, 0.0, 0.0, 0.0)) for i in range(len(self.times) + 1)]
+        self._start = np.array([p[0] for p in tail])
+        self._value = np.array([p[1] for p in tail])
+        self._slope = np.array([p[2] for p in tail])
+
+    @property
+    def breakpoints(self) -> tuple[float, ...]:
+        return self.times
+
+    def piece(self, t: float) -> int:
+        """The number of breakpoints at or before ``t``: 0 before the first, ``len(times)`` after the last."""
+        return bisect.bisect_right(self.times, t)
+
+    def equations(self, piece) -> str | None:
+        if piece not in self._pieces:
+            return None
+        start, value, slope, end, _ = self._pieces[piece]
+        if value == 0.0 and end == 0.0:
+            return None
+        if slope == 0.0:
+            return f"{{L}} = {value!r}"
+        return f"{{L}} = {value!r} + {slope!r} * (t - {start!r})"
+
+    def force(self, t):
+        ta = np.asarray(t, dtype=float)
+        i = np.searchsorted(np.asarray(self.times), ta, side="right")
+        out = self._value[i] + self._slope[i] * (ta - self._start[i])
+        return float(out) if np.ndim(t) == 0 else out
+
+    @property
+    def last_input_time(self) -> float:
+        return self.times[-1]
+
+    def impulse(self, t0: float = -math.inf, t1: float = math.inf) -> float:
+        """``integral_{t0}^{t1} L dt`` (N s), exact (each piece clipped to the interval, trapezoidal)."""
+        total = 0.0
+        for start, value, slope, _, end in self._pieces.values():
+            a, b = max(start, t0), min(end, t1)
+            if b > a:
+                fa, fb = value + slope * (a - start), value + slope * (b - start)
+                total += 0.5 * (fa + fb) * (b - a)
+        return total
+
+
+@dataclass(frozen=True)
+class Impulse:
+    """Velocity jumps of one body: at each of ``times`` (s) the velocity of ``body`` gains ``jump`` (m/s), an
+    impulse ``m jump`` (N s); the work of a jump from v is ``m ((v + jump)^2 - v^2) / 2`` (J)."""
+
+    name: str
+    body: str
+    times: tuple
+    jump: float
+
+    @property
+    def last_input_time(self) -> float:
+        return max(self.times, default=0.0)
+
+
 @dataclass(frozen=True)
 class Mode:
-    """The discrete state of every connector in one smooth segment (``mode[name]``; None: stateless)."""
+    """The discrete state of every connector in one smooth segment (``mode[name]``; None: stateless), and
+    the piece of every load's law (``loads``, one key per :attr:`Model.loads`, from :meth:`Load.piece`).
+
+    A mode without ``loads`` (``()``) of a model with loads evaluates each load's whole law
+    (:meth:`Load.force`) instead of one smooth piece: right for a state at a given time, not for
+    integrating across a breakpoint.
+    """
 
     names: tuple[str, ...]
     states: tuple
+    loads: tuple = ()
 
     def __getitem__(self, name: str):
         return self.states[self.names.index(name)]
 
     def __repr__(self) -> str:
         inner = ", ".join(f"{n}={s!r}" for n, s in zip(self.names, self.states) if s is not None)
-        return f"Mode({inner})"
-
-
-@dataclass(frozen=True)
-class Load:
-    """A constant external force ``force`` (N, positive in the recoil direction) on body ``body``, named ``name``
-    (gravity along an inclined cradle).  It acts on the body alone (not on the ground: no support force); its
-    work ``W = force (x_body(t) - x_body(0))`` (J) enters the energy balance: kinetic + stored + dissipated - W
-    stays the initial energy.  A load acting for ever leaves the mechanism without an energy bound."""
-
-    name: str
-    body: str
-    force: float
+        pieces = f"; load pieces {list(self.loads)}" if self.loads else ""
+        return f"Mode({inner}{pieces})"
 
 
 @dataclass(frozen=True)
@@ -234,32 +401,43 @@ class Evaluation:
 
 
 class Model:
-    """Bodies (barrel first), connectors (scene order) and roles (absorbers, stops) of one scene."""
+    """Bodies (barrel first), connectors (scene order), roles (absorbers, stops), external inputs (loads,
+    impulses) and the shot times of one scene.
 
-    def __init__(self, name: str, bodies, connectors, absorbers=(), stops=(), loads=()):
+    ``shot_times``: the times (s) the shots of a burst fire (None without a burst: one shot at t = 0): the
+    per-shot outputs of the result are taken between them, and every one is a time event of the solve.
+    """
+
+    def __init__(self, name: str, bodies, connectors, absorbers=(), stops=(), loads=(), impulses=(),
+                 shot_times=None):
         self.name = name
         self.bodies = tuple(bodies)
         self.connectors = tuple(connectors)
-        self.loads = tuple(loads)
         self.absorbers = tuple(absorbers)
         self.stops = tuple(stops)
+        self.loads = tuple(loads)
+        self.impulses = tuple(impulses)
+        self.shot_times = None if shot_times is None else tuple(float(t) for t in shot_times)
         if not self.bodies or self.bodies[0].name != BARREL:
             raise ReferenceModelError("the barrel must be the first body")
         names = [b.name for b in self.bodies]
-        for pool, what in ((names, "body"), ([c.name for c in self.connectors], "connector")):
+        inputs = [i.name for i in self.loads + self.impulses]
+        for pool, what in ((names, "body"), ([c.name for c in self.connectors], "connector"),
+                           (inputs, "external input")):
             duplicate = next((n for n in pool if pool.count(n) > 1), None)
             if duplicate is not None:
                 raise ReferenceModelError(f"{duplicate!r} names two {what}s")
         self.body_index = {n: i for i, n in enumerate(names)}
-        for load in self.loads:
-            if load.body not in self.body_index:
-                raise ReferenceModelError(f"load {load.name!r} acts on {load.body!r}, which is not a body")
-        #: (body index, force N) of every load
-        self.load_forces = tuple((self.body_index[load.body], float(load.force)) for load in self.loads)
+        for item in self.loads + self.impulses:
+            if item.body not in self.body_index:
+                raise ReferenceModelError(f"{item.name!r} acts on {item.body!r}, which is not a body")
         self.masses = [b.mass for b in self.bodies]
         self.n_bodies = len(self.bodies)
         self.dissipating = tuple(c for c in self.connectors if c.dissipates)
-        self.n_states = 2 * self.n_bodies + len(self.dissipating)
+        #: index of the work state of every load and impulse, by name
+        first_work = 2 * self.n_bodies + len(self.dissipating)
+        self.work_slot = {name: first_work + k for k, name in enumerate(inputs)}
+        self.n_states = first_work + len(inputs)
         slots = {c.name: 2 * self.n_bodies + k for k, c in enumerate(self.dissipating)}
         for j, c in enumerate(self.connectors):
             for end in (c.a, c.b):
@@ -291,6 +469,39 @@ class Model:
             raise KeyError(f"no body {name!r}; the scene has: {', '.join(self.body_index)}")
         return self.body_index[name]
 
+    # ------------------------------------------------------------------ external inputs
+    def load_pieces(self, t: float) -> tuple:
+        """The piece of every load's law on ``[t, next breakpoint)`` (the ``loads`` of a segment's mode)."""
+        return tuple(load.piece(t) for load in self.loads)
+
+    @property
+    def time_events(self) -> tuple[float, ...]:
+        """Times (s, > 0, sorted) where the solve is split: the loads' breakpoints, the impulses' times and
+        the shot times (a restart there, the mode classified again)."""
+        times = set(self.shot_times or ())
+        for load in self.loads:
+            times.update(load.breakpoints)
+        for impulse in self.impulses:
+            times.update(impulse.times)
+        return tuple(sorted(t for t in times if t > 0.0))
+
+    @property
+    def last_input_time(self) -> float:
+        """Time (s) after which no external input acts (0 without; inf under a load that never ends): energy
+        bounds hold only after it."""
+        return max([0.0] + [item.last_input_time for item in self.loads + self.impulses])
+
+    def apply_impulses(self, t: float, y: np.ndarray) -> np.ndarray:
+        """The state after the velocity jumps firing at ``t`` (s), their work added to their work states."""
+        y = np.array(y, dtype=float)
+        for impulse in self.impulses:
+            if t in impulse.times:
+                i = self.body_index[impulse.body]
+                v, dv = y[2 * i + 1], impulse.jump
+                y[2 * i + 1] = v + dv
+                y[self.work_slot[impulse.name]] += 0.5 * self.masses[i] * ((v + dv) ** 2 - v ** 2)
+        return y
+
     # ------------------------------------------------------------------ compiled equations
     def compiled(self, mode: Mode, kind: str, omit: int | None = None) -> Callable:
         """The compiled equations of ``mode`` (:func:`validation.reference.codegen.compile_mode`), cached."""
@@ -304,11 +515,18 @@ class Model:
         """``f(t, y) -> dy/dt`` in ``mode`` on Python floats (an overflow gives inf, as numpy would)."""
         return self.compiled(mode, "rhs")
 
-    def evaluate(self, mode: Mode, y, omit: int | None = None) -> Evaluation:
+    def evaluate(self, mode: Mode, y, omit: int | None = None, t=None) -> Evaluation:
         """Forces, accelerations and support force at a state ``y`` (n,) -- on Python floats -- or a batch
-        (n, N) -- on numpy rows.  ``omit``: leave out connector ``omit``'s force."""
+        (n, N) -- on numpy rows.  ``omit``: leave out connector ``omit``'s force.  ``t``: the time (s, a
+        float or an array of N; needed, and only read, when the model has loads)."""
         y = np.asarray(y, dtype=float)
-        return Evaluation(*self.compiled(mode, "scalar" if y.ndim == 1 else "array", omit)(y))
+        function = self.compiled(mode, "scalar" if y.ndim == 1 else "array", omit)
+        if not self.loads:
+            return Evaluation(*function(y))
+        if t is None:
+            raise ValueError(f"the model has loads ({', '.join(load.name for load in self.loads)}): "
+                             "evaluate needs the time t")
+        return Evaluation(*function(y, t if y.ndim == 1 else np.asarray(t, dtype=float)))
 
     def relative_acceleration(self, connector: Connector, evaluation: Evaluation):
         """d'' = a_b - a_a (m/s^2) of ``connector`` (the ground does not accelerate)."""
@@ -330,9 +548,9 @@ class Model:
         """D per dissipating connector (J): the state's last entries."""
         return {c.name: y[c.di] for c in self.dissipating}
 
-    def work_energies(self, y) -> dict[str, Any]:
-        """Work done by each load since t = 0 (J): ``force x_body`` (every body starts at x = 0)."""
-        return {load.name: force * y[2 * i] for load, (i, force) in zip(self.loads, self.load_forces)}
+    def works(self, y) -> dict[str, Any]:
+        """W per load and impulse (J): the work done on the bodies so far (states after the dissipations)."""
+        return {name: y[slot] for name, slot in self.work_slot.items()}
 
     def mechanical_energy(self, y):
         """Kinetic + stored energy (J) of a state or a batch."""

@@ -14,6 +14,7 @@ Names (DESIGN.md): bodies ``barrel`` and the absorbers' names; connectors ``reco
 
 from __future__ import annotations
 
+import math
 from dataclasses import asdict, dataclass, field
 from functools import cached_property
 from typing import Any, Callable
@@ -28,6 +29,8 @@ from .model import Mode, Model
 STOP_END_TIME = "end_time"
 STOP_METRICS_FINAL = "metrics_final"
 STOP_NO_BOUND = "end_time_no_energy_bound"
+#: A barrel within this distance (m) of x = 0 is in battery (the per-shot outputs of a burst).
+BATTERY_TOLERANCE = 1e-3
 _SUBDIVISIONS = 4
 #: Local maxima whose bracket stays this fraction of the value range below the best grid value are not
 #: refined: between two grid points (a quarter of a solver step) no solution rises that much.
@@ -110,16 +113,16 @@ def _best(candidates) -> tuple[float, float]:
 
 
 def _peak(segments, value: Callable, deriv: Callable) -> tuple[float, float]:
-    """Largest ``f = value(mode, y)`` over ``segments`` as ``(t, f)``: segment ends and interior maxima.
+    """Largest ``f = value(mode, y, t)`` over ``segments`` as ``(t, f)``: segment ends and interior maxima.
 
-    ``deriv(mode, y)`` is df/dt, or None where it has no closed form (then a bounded scalar maximisation
+    ``deriv(mode, y, t)`` is df/dt, or None where it has no closed form (then a bounded scalar maximisation
     around the segment's grid maximum).  Interior maxima are roots of df/dt where it falls through 0.
     """
     grids = []
     for seg in segments:
         tg = _grid(seg)
         yg = seg.sol(tg)
-        grids.append((seg, tg, yg, np.broadcast_to(value(seg.mode, yg), tg.shape)))
+        grids.append((seg, tg, yg, np.broadcast_to(value(seg.mode, yg, tg), tg.shape)))
     top = max(float(fg.max()) for *_, fg in grids)
     floor = top - _PRUNE * (top - min(float(fg.min()) for *_, fg in grids))
     out = []
@@ -127,19 +130,46 @@ def _peak(segments, value: Callable, deriv: Callable) -> tuple[float, float]:
         out += [(float(tg[0]), float(fg[0])), (float(tg[-1]), float(fg[-1]))]
         if fg.max() < floor:
             continue
-        dg = deriv(seg.mode, yg)
+        dg = deriv(seg.mode, yg, tg)
         if dg is None:  # no analytic derivative: bounded scalar maximisation around the grid maximum
             i = int(np.argmax(fg))
             if 0 < i < len(tg) - 1:
-                res = minimize_scalar(lambda s: -float(value(seg.mode, seg.sol(s))), bounds=(tg[i - 1], tg[i + 1]),
+                res = minimize_scalar(lambda s: -float(value(seg.mode, seg.sol(s), s)), bounds=(tg[i - 1], tg[i + 1]),
                                       method="bounded", options={"xatol": 1e-15})
                 out.append((float(res.x), -float(res.fun)))
             continue
         dg = np.broadcast_to(dg, tg.shape)
         for i in np.nonzero((dg[:-1] > 0) & (dg[1:] <= 0) & (np.maximum(fg[:-1], fg[1:]) >= floor))[0]:
-            tr = brentq(lambda s: float(deriv(seg.mode, seg.sol(s))), tg[i], tg[i + 1], xtol=1e-16, maxiter=200)
-            out.append((float(tr), float(value(seg.mode, seg.sol(tr)))))
+            tr = brentq(lambda s: float(deriv(seg.mode, seg.sol(s), s)), tg[i], tg[i + 1], xtol=1e-16, maxiter=200)
+            out.append((float(tr), float(value(seg.mode, seg.sol(tr), tr))))
     return _best(out)
+
+
+def _first_below(segments, t_from: float, level: float) -> float | None:
+    """First time >= ``t_from`` (s) at which x_M <= ``level`` (m) over ``segments``, by a scan of each
+    segment's grid (:func:`_grid`) and ``brentq`` on the dense output; None if it stays above."""
+    for seg in segments:
+        if seg.t1 < t_from:
+            continue
+        tg = _grid(seg)
+        tg = np.concatenate(([max(t_from, seg.t0)], tg[tg > t_from]))
+        x = seg.sol(tg)[0]
+        below = np.nonzero(x <= level)[0]
+        if not below.size:
+            continue
+        i = int(below[0])
+        if i == 0:
+            return float(tg[0])
+        return float(brentq(lambda s: float(seg.sol(s)[0]) - level, tg[i - 1], tg[i], xtol=1e-16, maxiter=200))
+    return None
+
+
+def _barrel_x(mode, y, t):
+    return y[0]
+
+
+def _barrel_v(mode, y, t):
+    return y[1]
 
 
 def _runs(segments, active: Callable) -> list[list[ReferenceSegment]]:
@@ -211,7 +241,8 @@ class ReferenceResult:
 
     # ---------------------------------------------------------------- evaluation
     def _per_segment(self, t, fn: Callable, rows: int | None):
-        """Evaluate ``fn(mode, y)`` at times ``t`` (scalar or array) using each time's segment."""
+        """Evaluate ``fn(mode, y, t)`` at times ``t`` (scalar or array) using each time's segment (at a
+        segment boundary the later one: the state after a shot's velocity jump)."""
         scalar = np.ndim(t) == 0
         ta = np.atleast_1d(np.asarray(t, dtype=float))
         span = 1e-12 * max(1.0, self.end_time)
@@ -222,27 +253,27 @@ class ReferenceResult:
         for i in np.unique(idx):
             sel = idx == i
             seg = self.segments[i]
-            out[..., sel] = fn(seg.mode, seg.sol(ta[sel]))
+            out[..., sel] = fn(seg.mode, seg.sol(ta[sel]), ta[sel])
         return out[..., 0] if scalar else out
 
     def _evaluated(self, t, pick: Callable, rows: int | None = None):
         """``pick(evaluation, y)`` of :meth:`Model.evaluate` at times ``t``."""
         model = self.model
-        return self._per_segment(t, lambda mode, y: pick(model.evaluate(mode, y), y), rows)
+        return self._per_segment(t, lambda mode, y, ts: pick(model.evaluate(mode, y, t=ts), y), rows)
 
     def state(self, t):
         """State ``[x_0, v_0, x_1, v_1, ..., D_0, ...]`` at ``t`` (s): shape (n,) or (n, len(t))."""
-        return self._per_segment(t, lambda mode, y: y, self.model.n_states)
+        return self._per_segment(t, lambda mode, y, ts: y, self.model.n_states)
 
     def position(self, body: str, t):
         """x of ``body`` (m)."""
         i = self.model.body(body)
-        return self._per_segment(t, lambda mode, y: y[2 * i], None)
+        return self._per_segment(t, lambda mode, y, ts: y[2 * i], None)
 
     def velocity(self, body: str, t):
         """v of ``body`` (m/s)."""
         i = self.model.body(body)
-        return self._per_segment(t, lambda mode, y: y[2 * i + 1], None)
+        return self._per_segment(t, lambda mode, y, ts: y[2 * i + 1], None)
 
     def acceleration(self, body: str, t):
         """a of ``body`` (m/s^2)."""
@@ -287,7 +318,7 @@ class ReferenceResult:
         if a is None:
             return 0.0 * self.barrel_position(t)
         c = self.model.connector(a.contact)
-        return self._per_segment(t, lambda mode, y: c.d_of(y) - c.offset, None)
+        return self._per_segment(t, lambda mode, y, ts: c.d_of(y) - c.offset, None)
 
     def contact_force(self, t):
         """Contact force F (N, >= 0) of the one absorber; 0 without absorber."""
@@ -320,24 +351,40 @@ class ReferenceResult:
         ``contact``, ...: only connectors that exist and dissipate)."""
         return {k: float(v) for k, v in self.dissipated_energy_history(self.end_time).items()}
 
-    def work(self, t) -> dict[str, np.ndarray]:
-        """Work done on the mechanism by each external load since t = 0 (J) at ``t``."""
-        return self.model.work_energies(self.state(t))
+    def work_history(self, t) -> dict[str, np.ndarray]:
+        """Work W (J) done on the bodies by each external input at ``t``, by name: a load's
+        ``integral_0^t L v_body dt`` (``breech_force``, ...), the velocity jumps' ``sum m ((v + dv)^2 - v^2) / 2``
+        (``burst``: the shots after the first).  Empty for a scene without inputs."""
+        return self.model.works(self.state(t))
+
+    @property
+    def work(self) -> dict[str, float]:
+        """:meth:`work_history` at ``end_time`` (J), by input."""
+        return {k: float(v) for k, v in self.work_history(self.end_time).items()}
+
+    def load_force(self, name: str, t):
+        """The external load ``name`` (N, on its body, positive in the recoil direction) at ``t`` (s)."""
+        loads = {load.name: load for load in self.model.loads}
+        if name not in loads:
+            raise KeyError(f"no load {name!r}; the scene has: {', '.join(loads) or 'none'}")
+        return loads[name].force(t)
 
     def energy_components(self, t) -> dict[str, np.ndarray]:
-        """The parts of the energy balance (J): ``kinetic:<body>``, ``stored:<connector>``,
-        ``dissipated:<connector>``, and ``work:<load>`` (the work of an external load); kinetic + stored +
-        dissipated - work is :meth:`energy_balance`."""
+        """The mechanical and dissipated parts of the energy balance (J): ``kinetic:<body>``,
+        ``stored:<connector>``, ``dissipated:<connector>``; :meth:`energy_balance` is their sum minus the
+        work of the external inputs (:meth:`work_history`)."""
         y = self.state(t)
         model = self.model
         return {**{f"kinetic:{k}": v for k, v in model.kinetic_energies(y).items()},
                 **{f"stored:{k}": v for k, v in model.stored_energies(y).items()},
-                **{f"dissipated:{k}": v for k, v in model.dissipated_energies(y).items()},
-                **{f"work:{k}": v for k, v in model.work_energies(y).items()}}
+                **{f"dissipated:{k}": v for k, v in model.dissipated_energies(y).items()}}
 
     def energy_balance(self, t):
-        """Total energy (J): kinetic + stored + dissipated - work of the loads; constant = initial_energy."""
-        return sum(-v if k.startswith("work:") else v for k, v in self.energy_components(t).items())
+        """Total energy (J): kinetic + stored + dissipated - work of the inputs; constant = initial_energy."""
+        total = sum(self.energy_components(t).values())
+        if self.model.work_slot:
+            total = total - sum(self.work_history(t).values())
+        return total
 
     @property
     def initial_energy(self) -> float:
@@ -348,7 +395,7 @@ class ReferenceResult:
         """Arrays on a time grid: the solver's step points (``n=None``), ``n`` uniform points, or given times.
 
         Keys: ``t``; ``x_M``, ``v_M``; ``x:<body>``, ``v:<body>``, ``F:<connector>``, ``E_<connector>``
-        (dissipated), ``support_force``; with at most one absorber also ``x_m``, ``v_m``,
+        (dissipated), ``load:<load>`` (N), ``work:<input>`` (J), ``support_force``; with at most one absorber also ``x_m``, ``v_m``,
         ``contact_force``, ``penetration`` (0 without absorber).
         """
         if n is None:
@@ -367,6 +414,10 @@ class ReferenceResult:
             out[f"F:{name}"] = self.connector_force(name, t)
         for name, history in self.model.dissipated_energies(y).items():
             out[f"E_{name}"] = history
+        for load in self.model.loads:
+            out[f"load:{load.name}"] = load.force(t)
+        for name, history in self.model.works(y).items():
+            out[f"work:{name}"] = history
         out["support_force"] = self.support_force(t)
         if len(self.model.absorbers) <= 1:
             out["x_m"], out["v_m"] = self.absorber_position(t), self.absorber_velocity(t)
@@ -376,20 +427,20 @@ class ReferenceResult:
     # ---------------------------------------------------------------- refined maxima
     def _force_value(self, j: int) -> Callable:
         c, model = self.model.connectors[j], self.model
-        return lambda mode, y: c.reported(model.evaluate(mode, y).forces[j])
+        return lambda mode, y, t: c.reported(model.evaluate(mode, y, t=t).forces[j])
 
     def _force_rate(self, j: int) -> Callable:
         """dF/dt of connector j (N/s), or None in a state without a closed form."""
         c, model = self.model.connectors[j], self.model
 
-        def rate(mode, y):
+        def rate(mode, y, t):
             return c.force_rate(mode.states[j], c.d_of(y), c.rate_of(y),
-                                model.relative_acceleration(c, model.evaluate(mode, y)))
+                                model.relative_acceleration(c, model.evaluate(mode, y, t=t)))
         return rate
 
     @cached_property
     def _barrel_max(self):
-        return _peak(self.segments, lambda mode, y: y[0], lambda mode, y: y[1])
+        return _peak(self.segments, _barrel_x, _barrel_v)
 
     @cached_property
     def _velocity_max(self) -> dict[str, tuple[float, float]]:
@@ -397,8 +448,8 @@ class ReferenceResult:
         model, out = self.model, {}
         for a in model.absorbers:
             i = model.body(a.body)
-            out[a.name] = _peak(self.segments, lambda mode, y: y[2 * i + 1],
-                                lambda mode, y: model.evaluate(mode, y).accelerations[i])
+            out[a.name] = _peak(self.segments, lambda mode, y, t: y[2 * i + 1],
+                                lambda mode, y, t: model.evaluate(mode, y, t=t).accelerations[i])
         return out
 
     @cached_property
@@ -444,18 +495,85 @@ class ReferenceResult:
         values = {c.index: self._force_value(c.index) for c in ground}
         rates = {c.index: self._force_rate(c.index) for c in ground}
 
-        def support(mode, y):
-            return sum(c.support_sign * values[c.index](mode, y) for c in ground)
+        def support(mode, y, t):
+            return sum(c.support_sign * values[c.index](mode, y, t) for c in ground)
 
-        def value(mode, y):
-            return np.abs(support(mode, y))
+        def value(mode, y, t):
+            return np.abs(support(mode, y, t))
 
-        def deriv(mode, y):
-            parts = [rates[c.index](mode, y) for c in ground]
+        def deriv(mode, y, t):
+            parts = [rates[c.index](mode, y, t) for c in ground]
             if any(p is None for p in parts):
                 return None
-            return np.sign(support(mode, y)) * sum(c.support_sign * p for c, p in zip(ground, parts))
+            return np.sign(support(mode, y, t)) * sum(c.support_sign * p for c, p in zip(ground, parts))
         return _peak(self.segments, value, deriv)
+
+    # ---------------------------------------------------------------- shots
+    def _window(self, k: int, times) -> list[ReferenceSegment]:
+        """The segments between shot ``k`` and the next one (or the end): the shot times are time events,
+        so segments never straddle them."""
+        w0 = times[k]
+        w1 = times[k + 1] if k + 1 < len(times) else self.end_time
+        return [seg for seg in self.segments if seg.t0 >= w0 and seg.t1 <= w1]
+
+    def _transient_impulse(self, t0: float, t1: float) -> float | None:
+        """``integral L dt`` (N s) over [t0, t1] of the loads that end (a breech pulse; not a constant load);
+        None without such a load."""
+        loads = [load for load in self.model.loads if math.isfinite(load.last_input_time)]
+        return sum(load.impulse(t0, t1) for load in loads) if loads else None
+
+    @property
+    def pulse_impulse(self) -> float | None:
+        """Impulse (N s) of the first shot's breech-force pulse (``integral F dt`` of the loads that end,
+        between the first and the second shot); None without a pulse."""
+        times = self.model.shot_times or (0.0,)
+        return self._transient_impulse(times[0], times[1] if len(times) > 1 else math.inf)
+
+    @cached_property
+    def shots(self) -> list[dict[str, Any]] | None:
+        """Per shot of a burst fired in ``[0, end_time)``, in order (None without a burst), a dict:
+
+        * ``shot`` (k + 1: 1, 2, ...), ``time`` (t_k, s);
+        * ``max_barrel_displacement`` (m) and ``time_of_max_barrel_displacement`` (s): the largest x_M over
+          ``[t_k, t_(k+1)]`` (the last shot: ``[t_k, end_time]``), refined on the dense output;
+        * ``position_at_next_shot`` (m), ``velocity_at_next_shot`` (m/s): x_M and v_M just before shot k + 1
+          fires (before its velocity jump); ``in_battery_at_next_shot``: ``|x_M| <=``
+          :data:`BATTERY_TOLERANCE` then (None for the last shot);
+        * ``time_to_battery`` (s after t_k): the first time after the window's maximum at which
+          ``x_M <= BATTERY_TOLERANCE`` (back within 1 mm of battery), found inside the window (None if it
+          does not return before the next shot or the end; the maximum itself if it is within 1 mm).
+
+        After an early stop (``stop_reason == "metrics_final"``) the last shot's maximum is None unless
+        ``max_barrel_displacement`` is final and lies in its window, and its ``time_to_battery`` is None
+        unless the return happened before the stop.
+        """
+        if self.model.shot_times is None:
+            return None
+        times = [t for t in self.model.shot_times if t == 0.0 or t < self.end_time]
+        stopped = self.stop_reason == STOP_METRICS_FINAL
+        out = []
+        for k, t_k in enumerate(times):
+            window = self._window(k, times)
+            last = k == len(times) - 1
+            t_max, x_max = _peak(window, _barrel_x, _barrel_v)
+            if last and stopped:
+                proven = self._final("max_barrel_displacement") and self._barrel_max[0] >= t_k
+                t_max, x_max = (t_max, x_max) if proven else (None, None)
+            shot = {"shot": k + 1, "time": t_k, "max_barrel_displacement": x_max,
+                    "time_of_max_barrel_displacement": t_max,
+                    "position_at_next_shot": None, "velocity_at_next_shot": None, "in_battery_at_next_shot": None}
+            if not last:
+                y = window[-1].sol(times[k + 1])
+                shot.update(position_at_next_shot=float(y[0]), velocity_at_next_shot=float(y[1]),
+                            in_battery_at_next_shot=bool(abs(y[0]) <= BATTERY_TOLERANCE))
+            if t_max is None:  # the window's maximum is not known: search from the window's largest so far
+                t_from = _peak(window, _barrel_x, _barrel_v)[0]
+            else:
+                t_from = t_max
+            back = _first_below(window, t_from, BATTERY_TOLERANCE)
+            shot["time_to_battery"] = None if back is None else back - t_k
+            out.append(shot)
+        return out
 
     # ---------------------------------------------------------------- metrics
     @property
@@ -576,4 +694,17 @@ class ReferenceResult:
             "final_metrics": list(self.final_metrics),
             "dissipated_energy": self.dissipated_energy,
             "wall_time": self.wall_time,
+            **self._input_metrics(),
         }
+
+    def _input_metrics(self) -> dict[str, Any]:
+        """``pulse_impulse`` (with a pulse), ``shots`` (with a burst), ``work`` (with external inputs): only
+        for scenes that have them (the version-1 keys stay as they were)."""
+        out: dict[str, Any] = {}
+        if self.pulse_impulse is not None:
+            out["pulse_impulse"] = self.pulse_impulse
+        if self.shots is not None:
+            out["shots"] = [dict(s) for s in self.shots]
+        if self.model.work_slot:
+            out["work"] = self.work
+        return out

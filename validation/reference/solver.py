@@ -9,10 +9,18 @@ output; the surfaces are the connectors', e.g. a contact's onset, release and cl
 damper's velocity sign).  At each restart the mode is chosen from the state
 (:class:`~validation.reference.switching.Restart`).  Metrics are refined on the dense output (root
 finding on the derivative), not taken from samples; see :mod:`validation.reference.result`.
+
+External inputs (:class:`~validation.reference.model.Load`, :class:`~validation.reference.model.Impulse`)
+add **time events** (:attr:`Model.time_events`): the breakpoints of every load (a segment integrates one
+smooth piece of its law), the times of the velocity jumps and the shot times.  A segment ends at the next
+time event at the latest; there the jumps firing at that time are applied to the state
+(:meth:`Model.apply_impulses`: ``v += dv``, the work ``m ((v + dv)^2 - v^2) / 2`` added) and the solve
+restarts with the mode classified again from the new state.  A scene without inputs or burst has none.
 """
 
 from __future__ import annotations
 
+import bisect
 import time
 
 import numpy as np
@@ -102,7 +110,7 @@ def solve_reference(scene, end_time: float = 10.0, *, method: str = "DOP853", rt
     ----------
     scene: the mechanism (a ``mbs_models`` Scene, read as data); every body starts at x = 0, the barrel at
         v0 (DESIGN.md), the absorbers at rest.
-    end_time: simulated time in s.
+    end_time: simulated time in s; shots and pulses after it do not happen.
     method: ``"DOP853"`` (default), ``"RK45"``, ``"Radau"`` or ``"LSODA"``.
     rtol, atol: solver tolerances; ``atol`` is in m and m/s for the mechanical states and is scaled by
         the initial energy (J, at least 1) for the dissipated-energy states.
@@ -114,8 +122,11 @@ def solve_reference(scene, end_time: float = 10.0, *, method: str = "DOP853", rt
         ``end_time``: checked at every segment end, and inside a segment by a terminal event (which
         leaves the solver's steps before it unchanged, so the window is the full run's prefix).  The
         result then covers ``[0, result.end_time]``, ``result.stop_reason == "metrics_final"``, and
-        metrics not proven final are None.  Scenes that inject energy (``literal_lambda_sign``) run
-        to ``end_time`` (``stop_reason == "end_time_no_energy_bound"``).
+        metrics not proven final are None.  Scenes that inject energy (``literal_lambda_sign``) or have
+        a load that never ends (a constant load) run to ``end_time`` (``stop_reason ==
+        "end_time_no_energy_bound"``).  With shots and pulses the bounds apply only from the last external
+        input on (:attr:`Model.last_input_time`: the last shot, the end of the last pulse): no stop
+        before it.
     refine_releases: integrate the solver step in which a power-law contact releases (``p = 0`` from
         above, where ``k p^n`` is only C^1 and the step's error estimate can miss its error) again from
         its start in at least 16 steps.  Off by default: version 1 did not, and its results are kept
@@ -136,7 +147,11 @@ def solve_reference(scene, end_time: float = 10.0, *, method: str = "DOP853", rt
     early = finality is not None and finality.enabled
     y = model.initial_state()
     e_scale = max(float(model.mechanical_energy(y)), 1.0)
-    atol_vec = atol * np.concatenate((np.ones(2 * model.n_bodies), np.full(len(model.dissipating), e_scale)))
+    atol_vec = atol * np.concatenate((np.ones(2 * model.n_bodies),
+                                      np.full(model.n_states - 2 * model.n_bodies, e_scale)))
+    #: the solve is split at these (shots, jumps, the loads' breakpoints); the bounds hold after the last input
+    time_events = [te for te in model.time_events if te < end_time]
+    last_input = model.last_input_time
     start = time.perf_counter()
     t, hints, stalls, nfev, previous = 0.0, {}, 0, 0, None
     segments: list[ReferenceSegment] = []
@@ -144,16 +159,19 @@ def solve_reference(scene, end_time: float = 10.0, *, method: str = "DOP853", rt
         if len(segments) >= max_segments:
             raise ReferenceSolveError(f"more than {max_segments} smooth segments before t = {t:.9g} s "
                                       f"(chattering / Zeno behaviour?) in scene {model.name!r}")
+        k = bisect.bisect_right(time_events, t)
+        t_bound = time_events[k] if k < len(time_events) else end_time
         restart = Restart(model, t, y, hints, previous)
         mode = previous = restart.mode
         funcs, names = restart.events()
-        stop = [finality.stop_event(mode)] if early else []
+        checking = early and t >= last_input  # no input acts from t on: the energy bounds hold
+        stop = [finality.stop_event(mode)] if checking else []
         options = dict(method=method, rtol=rtol, atol=atol_vec, max_step=max_step, events=(funcs + stop) or None)
-        sol = _integrate(model.rhs(mode), t, end_time, y, options, mode)
+        sol = _integrate(model.rhs(mode), t, t_bound, y, options, mode)
         nfev += sol.nfev
         hints = _hints(sol, funcs, names)
         if refine_releases and set(hints) & restart.rough and len(sol.t) >= 2:
-            sol = _refine_last_step(sol, model.rhs(mode), end_time, options, mode)
+            sol = _refine_last_step(sol, model.rhs(mode), t_bound, options, mode)
             nfev += sol.nfev_refinement
             hints = _hints(sol, funcs, names)
         t_new, y = float(sol.t[-1]), sol.y[:, -1].copy()
@@ -165,11 +183,12 @@ def solve_reference(scene, end_time: float = 10.0, *, method: str = "DOP853", rt
             segments.append(ReferenceSegment(t, t_new, mode, sol.sol))
         if early and t_new > t:
             finality.observe_segment(mode, sol.sol, t, t_new)
-            finality.check(y, mode)
-            if finality.done:
-                finality.check(y, mode, METRICS)  # which others are final here too
-                t = t_new
-                break
+            if checking:
+                finality.check(y, mode)
+                if finality.done:
+                    finality.check(y, mode, METRICS)  # which others are final here too
+                    t = t_new
+                    break
         if t_new - t <= 1e-14 * max(1.0, t):
             stalls += 1
             if stalls > _MAX_STALLS:
@@ -178,6 +197,8 @@ def solve_reference(scene, end_time: float = 10.0, *, method: str = "DOP853", rt
         else:
             stalls = 0
         t = t_new
+        if t == t_bound and t < end_time:  # a time event: the jumps firing now, then a restart
+            y = model.apply_impulses(t, y)
     stopped = early and finality.done and t < end_time
     if stopped:
         reason, final = STOP_METRICS_FINAL, tuple(m for m in METRICS if m in finality.final)

@@ -99,7 +99,9 @@ class Restart:
 
     ``hints``: ``"<connector>.<event>" -> bool`` for the events that stopped the previous segment (True:
     the surface was crossed upwards, the function is now positive); ``previous``: the previous segment's
-    mode (None at t = 0).  :attr:`mode` is the classified mode; :meth:`events` the segment's events.
+    mode (None at t = 0).  :attr:`mode` is the classified mode (with the loads' pieces from ``t`` on);
+    :meth:`events` the segment's events.  A restart after a time event (a shot's velocity jump, a load's
+    breakpoint) has no hints: every connector is classified from the state, as after any event.
     """
 
     def __init__(self, model: Model, t: float, y: np.ndarray, hints: dict[str, bool], previous: Mode | None):
@@ -111,13 +113,15 @@ class Restart:
         #: round-off levels of positions (m) and velocities (m/s)
         self.position_scale = max([1.0] + x)
         self.velocity_noise = 1e-15 * max([1.0] + v)
+        #: the pieces of the loads' laws on [t, next breakpoint)
+        self.pieces = model.load_pieces(t)
         connectors = model.connectors
         self.states = [c.provisional(self.s, self.previous_state(c)) for c in connectors]
         for stage in (1, 2):
             for j, c in enumerate(connectors):
                 if c.classify_pass == stage:
                     self.states[j] = c.classify(self)
-        self.mode = Mode(model.names, tuple(self.states))
+        self.mode = Mode(model.names, tuple(self.states), self.pieces)
 
     # ------------------------------------------------------------------ what connectors ask while classifying
     def hints_for(self, connector) -> dict[str, bool]:
@@ -130,7 +134,8 @@ class Restart:
         return None if self.previous is None else self.previous.states[connector.index]
 
     def _evaluate(self, omit=None):
-        return self.model.evaluate(Mode(self.model.names, tuple(self.states)), self.y, omit=omit)
+        return self.model.evaluate(Mode(self.model.names, tuple(self.states), self.pieces), self.y, omit=omit,
+                                   t=self.t)
 
     def free_relative_acceleration(self, connector) -> float:
         """d'' (m/s^2) of ``connector`` without its own force, the others in their current states."""
@@ -145,9 +150,10 @@ class Restart:
         return 1e-15 * max(self.position_scale, abs(offset))
 
     def force_function(self, connector):
-        """``y -> raw force`` (N) of ``connector`` in the classified mode, on a state or a batch."""
+        """``(t, y) -> raw force`` (N) of ``connector`` in the classified mode, on a state or a batch (the
+        time matters for a constraint force under a load)."""
         model, mode, j = self.model, self.mode, connector.index
-        return lambda y: model.evaluate(mode, y).forces[j]
+        return lambda t, y: model.evaluate(mode, y, t=t).forces[j]
 
     # ------------------------------------------------------------------ the segment's events
     def events(self):

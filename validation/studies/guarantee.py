@@ -93,6 +93,23 @@ def _impact_errors(ours_all, theirs_all, threshold: float, window: float, merge_
     return mismatch, time_error, peak_error
 
 
+def energy_scale(result, initial_energy: float) -> float:
+    """The energy (J) that relative energy errors refer to: the initial energy, plus the largest work the
+    external inputs (shots of a burst, a breech pulse, gravity) have done (a pulse starts at rest: 0 J)."""
+    if getattr(result, "work_histories", None):
+        return initial_energy + float(np.max(np.abs(result.work_history)))
+    return initial_energy
+
+
+def velocity_scale(scene) -> float:
+    """A velocity (m/s) for relative velocity errors: |v0|, or the shot's momentum / M with a breech pulse."""
+    v0 = abs(scene.initial_velocity)
+    firing = getattr(scene, "firing", None)
+    if firing is not None and getattr(firing, "pulse", None) is not None:
+        v0 = max(v0, firing.shot_momentum / scene.barrel.mass)
+    return v0
+
+
 def errors_against_reference(result, ref, merge_gap: float = 0.0) -> dict:
     """Errors of an engine ``result`` against a reference ``ref`` on the reference's window.
 
@@ -108,7 +125,7 @@ def errors_against_reference(result, ref, merge_gap: float = 0.0) -> dict:
     scene = result.scene
     window = ref.end_time
     full = window >= result.end_time
-    energy = ref.initial_energy
+    energy = energy_scale(result, ref.initial_energy)
     inside = result.time <= window + 1e-12
     out: dict = {}
 
@@ -129,7 +146,7 @@ def errors_against_reference(result, ref, merge_gap: float = 0.0) -> dict:
     out["S"] = abs(s_engine - ref.peak_support_force) / max(ref.peak_support_force, 1.0)
     out["F"] = out["v"] = out["time"] = out["peaks"] = 0.0
     out["impact_mismatch"] = 0
-    v0 = abs(scene.initial_velocity)
+    v0 = velocity_scale(scene)
     reference_absorbers = {a.name: a for a in ref.absorber_metrics}
     for name in result.absorber_names:
         v_engine = result.max_velocities[name][0]
@@ -171,7 +188,7 @@ def physical_violations(result, energy_tolerance: float = 1e-3) -> list[str]:
     for value in (result.max_barrel_displacement, result.total_dissipated_energy):
         if not math.isfinite(value):
             out.append(f"non-finite metric {value}")
-    e0 = result.kinetic_energy_history[0] + result.stored_energy_history[0]
+    e0 = energy_scale(result, result.kinetic_energy_history[0] + result.stored_energy_history[0])
     for name, history in result.dissipated_energy_history.items():
         if len(history) > 1 and np.min(np.diff(history)) < -energy_tolerance * e0:
             out.append(f"dissipated energy of {name} decreases")

@@ -115,7 +115,10 @@ def test_state_layout_and_connector_names(every_element, design_connectors):
     every = build_model(every_element(two_absorbers()))  # every other element: its connectors after the absorbers'
     assert every.names == design_connectors(every_element(two_absorbers())) and every.names[:6] == model.names
     assert [b.name for b in every.bodies] == ["barrel", "front", "rear"]
-    assert every.n_states == 2 * 3 + len(every.dissipating)
+    # then one work per external input (a burst's shots, a breech force), after the dissipated energies
+    inputs = [i.name for i in every.loads + every.impulses]
+    assert every.n_states == 2 * 3 + len(every.dissipating) + len(inputs)
+    assert [every.work_slot[name] for name in inputs] == list(range(2 * 3 + len(every.dissipating), every.n_states))
     one = build_model(model_ii())
     assert [b.name for b in one.bodies] == ["barrel", "absorber"]
     assert one.names == ("recoil_spring", "recoil_damper", "absorber_damper", "contact")

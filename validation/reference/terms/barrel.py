@@ -1,9 +1,11 @@
 """Term of ``[barrel]``: the recoiling barrel, body ``barrel`` of mass M (kg), starting at x = 0 with v0.
 
-v0 (m/s), DESIGN.md: ``barrel.initial_velocity``, or from ``[firing]`` the projectile momentum over the
-recoiling mass (:func:`validation.reference.terms.firing.recoil_velocity`): ``m_p v_p / M``, or
-``m_p v_p / (M + sum of the masses of the absorbers mounted on the barrel)`` with the
-``v0_includes_absorber`` reading; ``rounded_initial_velocity`` rounds v0 to 0.1 m/s (the paper's 0.7).
+v0 (m/s), DESIGN.md: ``barrel.initial_velocity``, or from ``[firing]`` the shot's momentum
+``I = m_p v_p + m_c v_g`` (with the powder gas's after-effect) over the recoiling mass
+(:func:`validation.reference.terms.firing.recoil_velocity`): ``I / M``, or
+``I / (M + sum of the masses of the absorbers mounted on the barrel)`` with the ``v0_includes_absorber``
+reading; 0 with a breech-force pulse (the barrel starts at rest); ``rounded_initial_velocity`` rounds v0
+to 0.1 m/s (the paper's 0.7).
 """
 
 from __future__ import annotations

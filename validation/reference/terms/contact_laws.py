@@ -269,8 +269,8 @@ class ContactConnector(Connector):
             k, n = self.law.stiffness, self.law.exponent
 
             def slip(t, y):
-                return sliding_force(y) - k * np.maximum(d_of(y) - offset, 0.0) ** n
-            return [("release", lambda t, y: sliding_force(y), True, None, 0.0), ("slip", slip, False, None, 0.0)]
+                return sliding_force(t, y) - k * np.maximum(d_of(y) - offset, 0.0) ** n
+            return [("release", sliding_force, True, None, 0.0), ("slip", slip, False, None, 0.0)]
         items = [("p", lambda t, y: d_of(y) - offset, state.penetrated, d_of(dy), restart.position_noise(offset))]
         if state.penetrated and self.law.has_clipping_surface:
             factor, surface = state.factor, self.surface

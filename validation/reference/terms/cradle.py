@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import math
 
-from ..model import BARREL, GROUND, Connector, Equations, ReferenceModelError
+from ..model import BARREL, GROUND, ConstantLoad, Connector, Equations, ReferenceModelError
 from ..switching import TOL_VEL
 
 TABLES = ("cradle",)
@@ -100,8 +100,8 @@ class CoulombFriction(Connector):
                      restart.velocity_noise)]
         held = restart.force_function(self)
         limit = self.force
-        return [("forward", lambda t, y: held(y) - limit, False, None, 0.0),
-                ("backward", lambda t, y: held(y) + limit, True, None, 0.0)]
+        return [("forward", lambda t, y: held(t, y) - limit, False, None, 0.0),
+                ("backward", lambda t, y: held(t, y) + limit, True, None, 0.0)]
 
     def force_bound(self, d_bound: float, rate_bound: float, penetration_bound: float) -> float:
         """``mu N`` (N)."""
@@ -116,7 +116,7 @@ def build(builder, key: str, table) -> None:
     normal = 0.0 if abs(float(table.elevation)) == 90.0 else mass * g * math.cos(theta)
     along = mass * g * math.sin(theta)
     if along != 0.0:
-        builder.add_load("gravity", BARREL, along)
+        builder.add_load(ConstantLoad("gravity", BARREL, along))
     if mu * normal > 0.0:
         if builder.scene.conventions.compression_only:
             raise ReferenceModelError("[cradle] friction with the compression_only reading: two sliding modes on "
