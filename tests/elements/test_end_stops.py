@@ -182,11 +182,13 @@ def test_the_reference_names_the_stops_after_their_tables(every_element):
     both dissipate (one dissipated energy each in the state)."""
     model = build_model(every_element())  # the shipped two absorbers and the shipped stops
     assert [b.name for b in model.bodies] == ["barrel", "front", "rear"]
-    assert model.names == ("recoil_spring", "recoil_damper", "front_damper", "front_contact", "rear_damper",
-                           "rear_contact", "recoil_stop", "battery_stop")
-    assert [c.name for c in model.dissipating] == ["recoil_damper", "front_damper", "front_contact", "rear_damper",
-                                                   "rear_contact", "recoil_stop", "battery_stop"]
-    assert model.n_states == 2 * 3 + 7 + len(model.work_slot)  # then the work of the inputs (a burst's shots)
+    # (the connectors of elements later in the assembly order, e.g. a cradle's friction, follow the stops)
+    assert model.names[:8] == ("recoil_spring", "recoil_damper", "front_damper", "front_contact", "rear_damper",
+                               "rear_contact", "recoil_stop", "battery_stop")
+    assert [c.name for c in model.dissipating][:7] == ["recoil_damper", "front_damper", "front_contact",
+                                                       "rear_damper", "rear_contact", "recoil_stop", "battery_stop"]
+    # then the work of the inputs (a burst's shots, loads)
+    assert model.n_states == 2 * 3 + len(model.dissipating) + len(model.work_slot)
 
 
 #: model (ii), m = 100 kg, with a hard recoil stop and a Kelvin-Voigt buffer 20 mm behind battery

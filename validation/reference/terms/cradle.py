@@ -34,6 +34,8 @@ from ..switching import TOL_VEL
 
 TABLES = ("cradle",)
 
+#: Machine epsilon (the relative round-off of a time).
+_EPS = 2.220446049250313e-16
 #: Friction modes.
 SLIP_FORWARD, SLIP_BACKWARD, STICK = "slip+", "slip-", "stick"
 
@@ -80,9 +82,12 @@ class CoulombFriction(Connector):
         if "backward" in hints:       # through F = -mu N
             return SLIP_BACKWARD
         rate = restart.s[self.ib + 1] - restart.s[self.ia + 1]
-        if "v" not in hints and abs(rate) > TOL_VEL:
-            return SLIP_FORWARD if rate > 0 else SLIP_BACKWARD
         needed = self.mass_b * restart.free_relative_acceleration(self)  # the force that holds v = 0
+        # on the surface v = 0 to within what the time's round-off allows at this acceleration (a restart
+        # located by another connector's event, e.g. a stiff stop, lands 1e-16 s off: v ~ a 1e-16 s)
+        noise = TOL_VEL + 8.0 * _EPS * max(1.0, abs(restart.t)) * (abs(needed) + self.force) / self.mass_b
+        if "v" not in hints and abs(rate) > noise:
+            return SLIP_FORWARD if rate > 0 else SLIP_BACKWARD
         if abs(needed) <= self.force:
             return STICK
         return SLIP_FORWARD if needed > 0 else SLIP_BACKWARD
