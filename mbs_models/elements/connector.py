@@ -164,6 +164,16 @@ class Connector:
         enters the quadratic form of the energy bounds."""
         return self.stiffness
 
+    @property
+    def first_step_limit(self) -> float:
+        """Largest first step (s) an adaptive solve may take for this connector (default: inf, no limit).
+
+        Exudyn's adaptive solvers start with their maximum step; a law whose force can grow faster than
+        linearly within that step (a quadratic damper far stiffer than the step) sends the trial step's
+        error beyond what its step-size control can reject.  Such a connector names the time scale of
+        its fastest motion here; the engine starts the solve with the smallest of these limits."""
+        return math.inf
+
     def force_bound(self, d_bound: float, rate_bound: float, energy: float) -> float:
         """Bound (N) on |F| when |d| <= ``d_bound`` (m) and |d'| <= ``rate_bound`` (m/s) and the
         mechanical energy is ``energy`` (J) at most."""

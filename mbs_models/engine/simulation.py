@@ -188,6 +188,9 @@ def _solve(assembly: Assembly, settings: SolverSettings, end_time: float,
     """
     mbs = assembly.mbs
     ss = exudyn_simulation_settings(settings, end_time, start_time)
+    first_step = min((c.first_step_limit for c in assembly.mechanism.connectors), default=math.inf)
+    if settings.adaptive and first_step < settings.max_step:  # else Exudyn starts with max_step
+        ss.timeIntegration.initialStepSize = first_step
     solver_type = getattr(exudyn.DynamicSolverType, settings.solver)
     run = {} if run is None else run
     if "budget" not in run:

@@ -40,8 +40,12 @@ def scenes(every_element) -> dict:
 
 @pytest.fixture(scope="module")
 def solved(scenes):
-    """``solved(key)``: the reference solution of ``scenes[key]`` over END (cached)."""
-    return functools.lru_cache(maxsize=None)(lambda key: solve_reference(scenes[key], END))
+    """``solved(key)``: the reference solution of ``scenes[key]`` over END (cached).  The scenes of every element
+    refine the power-law releases (``refine_releases``; the default keeps version 1's record): their stops'
+    ``k p^n`` is only C^1 at release, and one long step across a recoil-stop release lost 4.5e-7 of the energy
+    of ii-every-element once the recoil brake joined the elements (2.6e-10 refined)."""
+    return functools.lru_cache(maxsize=None)(lambda key: solve_reference(scenes[key], END,
+                                                                         refine_releases=key in EVERY))
 
 
 def grid(n=4001):
@@ -64,11 +68,10 @@ def test_names_follow_design(solved, scenes, design_connectors):
     others = other_contacts(scene)
     assert others and set(r.contacts) == {"front_contact", "rear_contact"} | others
     assert [m.name for m in r.absorber_metrics] == ["front", "rear"] and set(r.stop_metrics) == others
-    # every connector of this scene but the pure spring damps (all its contact laws do); the springs and every
-    # contact store energy, the pure damper does not
+    # every connector of this scene but the pure spring damps (all its contact laws do); the springs (the recoil
+    # spring, the absorbers' actuators) and the contacts store energy, nothing else (DESIGN.md, "Energy")
     assert set(r.dissipated_energy) == set(r.connectors) - {"recoil_spring"}
-    stored = set(r.stored_energy(0.1))
-    assert "recoil_damper" not in stored and set(r.connectors[:6]) - {"recoil_damper"} | set(r.contacts) <= stored
+    assert set(r.stored_energy(0.1)) == {"recoil_spring", "front_damper", "rear_damper"} | set(r.contacts)
     assert set(r.kinetic_energy(0.1)) == {"barrel", "front", "rear"}
     one = solved("ii")
     assert one.bodies == ("barrel", "absorber") and one.connectors[-2:] == ("absorber_damper", "contact")
