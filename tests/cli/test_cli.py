@@ -122,7 +122,10 @@ def test_run_json_of_a_version_2_scene_has_the_new_keys(tmp_path, capsys, every_
     # the contacts of the other tables are the stops, named like their tables (DESIGN.md)
     stops = [name for name, table in scene.elements() if isinstance(table, LawFields)]
     assert stops and [s["name"] for s in data["stops"]] == stops
-    assert all(s["peak_contact_force"] > 0 and s["dissipated_energy"] > 0 for s in data["stops"])
+    # every stop reached is reported with its force and energy (one out of reach -- gravity keeping an unpreloaded
+    # barrel from battery -- with neither)
+    assert any(s["peak_contact_force"] > 0 for s in data["stops"])
+    assert all((s["peak_contact_force"] > 0) == (s["dissipated_energy"] > 0) for s in data["stops"])
     # per element: kinetic + stored + dissipated - work of the external inputs (shots, loads) = initial energy
     energy = sum(parts["kinetic"] + parts["stored"] + parts["dissipated"] - parts.get("work", 0.0)
                  for parts in data["energy"].values())

@@ -99,12 +99,14 @@ def test_histories_are_derivatives_of_each_other(key, solved):
 
 @pytest.mark.parametrize("key", KEYS)
 def test_support_force_is_minus_the_rate_of_momentum(key, solved):
-    """With no external force S = -(M a_M + sum m_i a_i), to round-off of the forces."""
+    """S = -(M a_M + sum m_i a_i) plus the external loads (which act on a body, not through the mount), to
+    round-off of the forces."""
     r = solved(key)
     t = grid()
     momentum_rate = sum(mass * r.acceleration(b, t) for b, mass in zip(r.bodies, [b.mass for b in r.model.bodies]))
+    loads = sum((load.force(t) for load in r.model.loads), 0.0 * t)
     scale = max(np.max(np.abs(r.connector_force(c, t))) for c in r.connectors)
-    np.testing.assert_allclose(r.support_force(t), -momentum_rate, rtol=0, atol=1e-9 * scale)
+    np.testing.assert_allclose(r.support_force(t), loads - momentum_rate, rtol=0, atol=1e-9 * scale)
 
 
 def test_support_force_of_the_paper_model_is_its_grounded_connectors_forces(solved):
@@ -145,11 +147,13 @@ def test_energy_balance_closes_part_by_part(key, solved, scenes):
     t = grid()
     total = sum(r.kinetic_energy(t).values()) + sum(r.stored_energy(t).values()) + \
         sum(r.dissipated_energy_history(t).values())
-    total = total - sum(r.work_history(t).values(), 0.0 * t)  # the work of a burst's later shots
+    work = sum(r.work_history(t).values(), 0.0 * t)  # the work of a burst's later shots and of loads (gravity)
+    total = total - work
     np.testing.assert_allclose(total, r.energy_balance(t), rtol=1e-13)
     assert r.initial_energy == pytest.approx(0.5 * scenes[key].barrel.mass * scenes[key].initial_velocity ** 2,
                                              rel=1e-15)
-    assert np.max(np.abs(total - r.initial_energy)) < 1e-7 * r.initial_energy
+    # relative to the energy that flows through the mechanism: the initial energy and the largest work done
+    assert np.max(np.abs(total - r.initial_energy)) < 1e-7 * (r.initial_energy + np.max(np.abs(work)))
     for name, history in r.dissipated_energy_history(t).items():
         assert np.all(np.diff(history) >= -1e-9 * r.initial_energy), name  # every connector only dissipates
 
@@ -184,11 +188,13 @@ def test_largest_over_absorbers_and_impacts_in_time_order(solved):
     assert sorted((i.start, i.contact) for i in r.impacts) == sorted(
         (i.start, i.contact) for m in per.values() for i in m.impacts)
     assert {i.contact for i in r.impacts} == {"front_contact", "rear_contact"}  # both absorbers are hit
-    assert r.stop_metrics
+    assert r.stop_metrics and any(stop.impacts for stop in r.stop_metrics.values())
     for stop in r.stop_metrics.values():  # stops are not absorbers' impacts
         assert all(i.contact == stop.name for i in stop.impacts)
         assert stop.impacts == r.contacts[stop.name].impacts
-        assert stop.dissipated_energy == r.dissipated_energy[stop.name] > 0
+        # (a stop the barrel never reaches -- gravity keeps an unpreloaded barrel from battery -- dissipates 0)
+        assert stop.dissipated_energy == r.dissipated_energy[stop.name] >= 0
+        assert (stop.dissipated_energy > 0) == bool(stop.episodes)
 
 
 def test_contact_episodes_and_onsets(solved):
@@ -209,7 +215,10 @@ def test_contact_episodes_and_onsets(solved):
         for time, v_minus in contact.onsets:  # onset: p = 0 turning positive at the rate v-
             assert abs(c.d_of(r.state(time)) - c.offset) < 1e-12
             assert c.rate_of(r.state(time)) == pytest.approx(v_minus, rel=1e-9, abs=1e-12)
-        assert len(contact.onsets) >= len(contact.episodes) > 0
+        assert len(contact.onsets) >= len(contact.episodes)
+        assert contact.episodes or name in r.stop_metrics, name  # a stop may be out of reach (gravity)
+    assert all(r.contacts[f"{m.name}_contact"].episodes for m in r.absorber_metrics)
+    assert any(r.contacts[name].episodes for name in r.stop_metrics)
 
 
 def test_restitution_laws_use_the_onset_rate_of_their_episode(solved):
@@ -241,7 +250,8 @@ def test_metrics_dictionary(solved):
     assert m["stops"] and set(m["stops"]) == set(r.stop_metrics)
     assert set(m["impacts"][0]) == {"start", "end", "peak_force", "time_of_peak", "contact"}
     for name, stop in m["stops"].items():
-        assert stop["dissipated_energy"] == m["dissipated_energy"][name] > 0
+        assert stop["dissipated_energy"] == m["dissipated_energy"][name] >= 0
+    assert any(stop["dissipated_energy"] > 0 for stop in m["stops"].values())
     import json
     json.dumps(m)  # plain values
 
