@@ -347,3 +347,14 @@ def test_engine_against_reference_standard(name, agrees_with_reference):
 @pytest.mark.parametrize("name", list(ENGINE_CASES))
 def test_engine_against_reference_every_preset(name, accuracy, agrees_with_reference):
     agrees_with_reference(*ENGINE_CASES[name], accuracy)
+
+
+def test_the_brake_design_refuses_a_recoil_length_beyond_the_recoil_stop():
+    """``recoil design-brake`` (mbs_models.studies.brake_design) finds a stop within the stroke generically."""
+    from mbs_models import SceneError
+    from mbs_models.studies.brake_design import design_brake
+
+    stop = RecoilStop(position=0.2, stiffness=1e9, exponent=1.5, damping_factor=0.5)
+    with pytest.raises(SceneError, match=r"shorter than the position of \[recoil_stop\] \(0.2 m\)"):
+        design_brake(simplified_model().with_changes(recoil_stop=stop), 0.22)
+    assert design_brake(simplified_model().with_changes(recoil_stop=stop), 0.18).recoil_length == 0.18
