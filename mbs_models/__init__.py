@@ -39,6 +39,7 @@ _LAZY = {
     "EnergyBounds": ".engine.final_metrics",
     "add_contact": ".elements.contact_laws",
     "add_recoil_damper": ".elements.recoil_damper",
+    "add_recuperator": ".elements.recuperator",
     "add_body": ".engine.assembly",
 }
 
