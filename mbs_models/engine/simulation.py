@@ -378,7 +378,9 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
     energy_error = (result.kinetic_energy_history + result.stored_energy_history
                     + sum(result.dissipated_energy_history.values()) - mechanism.initial_energy())
     stability.check_energy_balance(scene, samples.time, energy_error, f"Exudyn {settings.label()}")
-    if stopped and largest_energy_rise(result.kinetic_energy_history + result.stored_energy_history) > ENERGY_SLACK:
+    floor = tracker.bounds.energy_floor if stopped else 0.0  # the energy's lower bound (a preload's well)
+    if stopped and largest_energy_rise(result.kinetic_energy_history + result.stored_energy_history - floor) \
+            > ENERGY_SLACK:
         # the solution's energy rose by more than the bounds' slack: do not trust the early stop
         result = simulate(scene, end_time, settings, impact_threshold=impact_threshold)
         result.stop_reason = STOP_ENERGY_CHECK
