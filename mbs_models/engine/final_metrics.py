@@ -505,8 +505,8 @@ class EnergyBounds:
         for c, coefficient, rate_coefficient in self._ground:
             if c.is_contact:
                 total += self.contact_force_bound(contact_index[id(c)], energy)
-            elif self._in_well(c):
-                total += c.force_bound(self.well.upper(c, e), math.sqrt(rate_coefficient * e), e)
+            elif self._in_well(c):  # |d| <= max(|lo|, |hi|) of the well's interval
+                total += c.force_bound(self.well.magnitude(c, e), math.sqrt(rate_coefficient * e), e)
             else:
                 total += c.force_bound(math.sqrt(coefficient * e), math.sqrt(rate_coefficient * e), e)
         return total
