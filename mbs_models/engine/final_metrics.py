@@ -447,7 +447,7 @@ class EnergyBounds:
             if not self._in_well(stop):
                 bound = min(bound, stop.offset + stop.penetration_bound(e))
         if self.well is not None and self.well.body == 0:
-            bound = min(bound, self.well.end(1.0, e))
+            bound = min(self.well.end(1.0, e), bound)  # (bound is nan for inf * 0: no spring on the barrel, E' = 0)
         return bound
 
     def body_velocity(self, i: int, energy: float) -> float:
