@@ -316,8 +316,8 @@ def test_the_recuperator_alone_is_conservative():
     result = simulate(ALONE, 3.0, "reference")
     energy = result.kinetic_energy_history + result.stored_energy_history
     assert energy[0] == pytest.approx(e0, rel=1e-13)
-    assert np.max(np.abs(energy - e0)) < 1e-9 * e0
-    assert np.max(np.abs(result.energy_error())) < 1e-9 * e0
+    assert np.max(np.abs(energy - e0)) < 1e-9 * e0  # measured 5.4e-10
+    assert np.max(np.abs(result.energy_error())) < 2e-9 * e0  # with the stop's quadrature (measured 9.8e-10)
     assert result.dissipated_energy["battery_stop"] == pytest.approx(0.0, abs=1e-9 * e0)
     assert result.max_barrel_displacement == pytest.approx(x_max, rel=1e-9)
     assert len(result.contacts["battery_stop"].impacts) >= 2  # it bounces back from the stop, again and again
