@@ -61,9 +61,10 @@ Ties keep the earliest time, as the peak refinement does.  The observed values a
 solution, hence lower bounds of its refined maxima: a metric proven final from samples is final.
 
 Numerical slack: a numerical solution dissipates energy only up to its integration error, so the
-bounds use ``E (1 + ENERGY_SLACK)`` (``W* + E' (1 + ENERGY_SLACK)`` with a potential well).  :func:`mbs_models.simulate` trusts an early stop only if the
-solution's energy rose by no more than that fraction anywhere in the simulated window
-(:func:`largest_energy_rise`), and otherwise re-solves to the end time.
+bounds use ``E (1 + ENERGY_SLACK)`` (``W* + E' (1 + ENERGY_SLACK)`` with a potential well).
+:func:`mbs_models.simulate` trusts an early stop only if the solution's energy (above the well's floor)
+rose by no more than that fraction anywhere in the simulated window (:func:`largest_energy_rise`), and
+otherwise re-solves to the end time.
 """
 
 from __future__ import annotations
@@ -181,7 +182,8 @@ class PotentialWell:
 
     @classmethod
     def of(cls, mechanism: Mechanism) -> "PotentialWell | None":
-        general = [c for c in mechanism.connectors if c.stores_energy and not c.is_contact and not c.quadratic_potential]
+        general = [c for c in mechanism.connectors
+                   if c.stores_energy and not c.is_contact and not c.quadratic_potential]
         return cls(mechanism, general) if general else None
 
     def __contains__(self, connector) -> bool:
@@ -326,7 +328,8 @@ class EnergyBounds:
             kinetic = [index[b.name] for b in element.bodies]
             springs = [c for c in element.connectors if c.stores_energy and not c.is_contact and c.quadratic_potential]
             contacts = [c for c in element.connectors if c.is_contact]
-            general = [c for c in element.connectors if c.stores_energy and not c.is_contact and not c.quadratic_potential]
+            general = [c for c in element.connectors
+                       if c.stores_energy and not c.is_contact and not c.quadratic_potential]
             self._groups.append((kinetic, springs, contacts, general))
         #: the potential well of a connector whose potential is not a quadratic form (None: there is none)
         self.well = PotentialWell.of(mechanism)

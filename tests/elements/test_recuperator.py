@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 import tomllib
 
-from mbs_models import (Absorber, Barrel, BatteryStop, Contact, Firing, RecoilDamper, RecoilSpring, RecoilStop,
+from mbs_models import (Barrel, BatteryStop, Firing, RecoilDamper, RecoilSpring, RecoilStop,
                         Recuperator, Scene, SceneError, load_scene, model_i, model_ii, simulate)
 from mbs_models.cli import main
 from mbs_models.elements import ELEMENT_TABLES
@@ -208,8 +208,9 @@ def test_a_preload_that_cannot_return_the_barrel_against_gravity_and_friction_is
     """p0 A <= M g (sin(elevation) + mu cos(elevation)): checked with the scene's [cradle] (a stand-in here: the
     cradle's table comes with its own element), the message gives both forces in N."""
     resisting = 5600.0 * G * (math.sin(math.radians(30.0)) + 0.1 * math.cos(math.radians(30.0)))  # 32 222 N
+    cradle = SimpleNamespace(elevation=30.0, gravity=G, friction_coefficient=0.1)
     scene = SimpleNamespace(barrel=Barrel(5600.0, initial_velocity=0.0), battery_stop=EXAMPLE.battery_stop,
-                            recoil_stop=None, cradle=SimpleNamespace(elevation=30.0, gravity=G, friction_coefficient=0.1))
+                            recoil_stop=None, cradle=cradle)
     with pytest.raises(SceneError) as info:
         GAS.check_in_scene(scene, "recuperator")
     assert info.value.key == "recuperator.initial_pressure"

@@ -47,7 +47,8 @@ class GasSpring(Connector):
 
     def __init__(self, name: str, a: str, b: str, pressure: float, area: float, volume: float, exponent: float):
         super().__init__(name, a, b)
-        self.pressure, self.area, self.volume, self.exponent = float(pressure), float(area), float(volume), float(exponent)
+        self.pressure, self.area = float(pressure), float(area)
+        self.volume, self.exponent = float(volume), float(exponent)
         self.preload = self.pressure * self.area
         self.d_limit = self.volume / self.area
 
