@@ -40,6 +40,7 @@ _LAZY = {
     "add_contact": ".elements.contact_laws",
     "add_recoil_damper": ".elements.recoil_damper",
     "add_recoil_brake": ".elements.recoil_brake",
+    "add_recuperator": ".elements.recuperator",
     "add_body": ".engine.assembly",
 }
 

@@ -1,7 +1,9 @@
 """Bodies and connectors: what every element is made of, and what the engine iterates over.
 
 A recoil mechanism here is one-dimensional: every :class:`Body` moves along the recoil axis
-(position positive in the recoil direction, 0 at the start), and every force acts between two points
+(position positive in the recoil direction, 0 at battery; a body starts at its ``initial_position``, 0
+unless an element holds it elsewhere, see :meth:`~mbs_models.elements.table.Table.initial_positions`),
+and every force acts between two points
 of that axis -- two bodies, or a body and the ground (:data:`GROUND`).  Such a force is a
 :class:`Connector` between point ``a`` and point ``b``::
 
@@ -38,12 +40,14 @@ GROUND = "ground"
 
 @dataclass(frozen=True)
 class Body:
-    """A mass on the recoil axis: ``name``, ``mass`` (kg), ``initial_velocity`` (m/s); it starts at x = 0."""
+    """A mass on the recoil axis: ``name``, ``mass`` (kg), ``initial_velocity`` (m/s), ``initial_position`` (m;
+    0 unless an element holds the body elsewhere at t = 0, e.g. a preload against the battery stop)."""
 
     name: str
     mass: float
     initial_velocity: float = 0.0
     element: str = ""
+    initial_position: float = 0.0
 
 
 #: ``quadrature(power_at_nodes) -> cumulative energy`` over the output samples (J): see
@@ -71,6 +75,10 @@ class Connector:
     needs_user_function = False
     records_force = False
     is_contact = False
+    #: True when the stored energy is the quadratic form ``linear_stiffness d^2 / 2`` (or none): the energy
+    #: bounds of the early stop then use it as such.  False for a nonlinear potential, which may also be
+    #: negative (the recuperator's gas spring): the bounds treat it separately.
+    quadratic_potential = True
 
     def __init__(self, name: str, element: str, a: str, b: str, *, stiffness: float = 0.0, damping: float = 0.0):
         if a == b:
@@ -143,6 +151,15 @@ class Connector:
     def stored_energy(self, d):
         """Stored (potential) energy in J at ``d`` (m): ``stiffness d^2 / 2``."""
         return 0.5 * self.stiffness * np.asarray(d, dtype=float) ** 2
+
+    def python_stored_energy(self, d: float) -> float:
+        """:meth:`stored_energy` at one ``d`` (m), a plain float (J)."""
+        return float(self.stored_energy(d))
+
+    @property
+    def coordinate_range(self) -> tuple[float, float]:
+        """(lowest, highest) d in m where the law is defined (all of it, but for a gas spring's singularity)."""
+        return -math.inf, math.inf
 
     def dissipated_energy(self, quadrature: Quadrature, d_nodes, rate_nodes, times_nodes, stored):
         """Cumulative dissipated energy (J) at the output samples: ``damping d'^2`` integrated.

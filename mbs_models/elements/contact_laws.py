@@ -433,6 +433,8 @@ class ContactConnector(Connector):
             return 0.5 * self.contact_stiffness * p * p
         return p ** (self.exponent + 1.0) / ((self.exponent + 1.0) / self.contact_stiffness)
 
+    python_stored_energy = python_elastic
+
     # ------------------------------------------------------------------ energy
     @property
     def stores_energy(self) -> bool:

@@ -175,3 +175,9 @@ class Table:
     def check_in_scene(self, scene, key: str) -> None:
         """Checks that need the whole scene (e.g. a stop's position against the other stop); ``key`` is
         this table's place in the scene (``"absorber.1"``).  Default: none."""
+
+    def initial_positions(self, scene, name: str, bodies, connectors) -> dict[str, float]:
+        """Positions (m) at t = 0 that this element imposes, by body name, given every body and connector of
+        the scene (a preload holding the barrel against its battery stop).  Default: none -- every body starts
+        at x = 0."""
+        return {}

@@ -81,9 +81,10 @@ class Assembly:
         self.close()
 
 
-def add_body(mbs, mass: float, initial_velocity: float = 0.0):
-    """Add a 1-D body (m in kg, at x = 0 with ``initial_velocity`` m/s) to ``mbs``: (node, coordinate marker)."""
-    node = mbs.AddNode(NodeGenericODE2(referenceCoordinates=[0.0], initialCoordinates=[0.0],
+def add_body(mbs, mass: float, initial_velocity: float = 0.0, initial_position: float = 0.0):
+    """Add a 1-D body (m in kg, at ``initial_position`` m, default 0, with ``initial_velocity`` m/s) to ``mbs``:
+    (node, coordinate marker).  The reference coordinate is 0: the node's coordinate is the position x."""
+    node = mbs.AddNode(NodeGenericODE2(referenceCoordinates=[0.0], initialCoordinates=[initial_position],
                                        initialCoordinates_t=[initial_velocity], numberOfODE2Coordinates=1))
     mbs.AddObject(ObjectMass1D(nodeNumber=node, mass=mass))
     marker = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=node, coordinate=0))
@@ -103,7 +104,7 @@ def assemble(scene: Scene, user_functions: str = "symbolic", mechanism: Mechanis
     assembly.markers[GROUND] = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=ground, coordinate=0))
     for element in mechanism.elements:
         for body in element.bodies:
-            node, marker = add_body(mbs, body.mass, body.initial_velocity)
+            node, marker = add_body(mbs, body.mass, body.initial_velocity, body.initial_position)
             assembly.nodes[body.name], assembly.markers[body.name] = node, marker
             for quantity, ovt in (("position", _OVT.Coordinates), ("velocity", _OVT.Coordinates_t),
                                   ("acceleration", _OVT.Coordinates_tt)):
@@ -125,5 +126,5 @@ def assemble(scene: Scene, user_functions: str = "symbolic", mechanism: Mechanis
     assembly.coordinates = {name: data.GetNodeLTGODE2(node)[0] for name, node in assembly.nodes.items()}
     velocities = {body.name: body.initial_velocity for body in mechanism.bodies}
     for contact in mechanism.capturing_contacts:
-        contact.start(0.0, mechanism.relative(contact, velocities))
+        contact.start(mechanism.initial_relative(contact), mechanism.relative(contact, velocities))
     return assembly

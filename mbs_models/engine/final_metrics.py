@@ -32,6 +32,22 @@ Bounds (every term of E is >= 0, so each is <= E(t) at every later time)
   ``c |d'|``, a contact ``k p^n (1 + lambda |p'|)``, with lambda = chi / minimum_impact_velocity for the
   restitution laws); the force on the mount by the sum over the connectors touching the ground.
 
+A potential that is not a quadratic form (the recuperator's gas spring)
+---------------------------------------------------------------------
+A connector with ``quadratic_potential = False`` has a nonlinear potential that may be negative (the gas
+spring ``U(d) = integral_0^d F``, with ``F > 0``, is negative where the preload holds the barrel forward of
+battery), so "every term <= E" fails.  Such connectors between the ground and one body b, together with
+b's contacts with the ground (the stops), form a **potential well** ``W(x_b) = sum U_c(+-x_b)``: convex
+(each ``U_c`` is, its force being non-decreasing in ``d``), with a minimum ``W*`` at the static
+equilibrium ``W'(x*) = 0`` (:class:`PotentialWell`).  Every other term of E is >= 0, and so is ``W - W*``;
+so with the energy above the floor, ``E' = E - W*`` (>= 0), every bound above holds with E' in place of
+E, and the well adds its own: ``W(x_b) <= W* + E'`` confines ``x_b`` to the sublevel interval
+``[lo(E'), hi(E')]`` of W (found by root finding; ``hi < V0/A`` for the gas spring, whose potential
+diverges there).  That interval bounds x_b (``x_M <= hi``), every member's coordinate (a stop's
+penetration, the gas spring's stroke, hence their forces).  The numerical slack applies to E'.  A
+connector with such a potential anywhere else (not between the ground and one body, or in a well with
+no minimum) leaves the scene without bounds: it runs to its end time.
+
 Finality (what :class:`FinalityTracker` decides from the states it is shown)
 ---------------------------------------------------------------------------
 * ``max_barrel_displacement`` (and its time): final once the x_M bound <= the largest x_M seen;
@@ -49,9 +65,10 @@ to states after the last of them (:attr:`Mechanism.last_input_time`); a load tha
 along an inclined cradle) leaves the scene without a bound (:func:`dissipative` is False).
 
 Numerical slack: a numerical solution dissipates energy only up to its integration error, so the
-bounds use ``E (1 + ENERGY_SLACK)``.  :func:`mbs_models.simulate` trusts an early stop only if the
-solution's energy rose by no more than that fraction anywhere in the simulated window
-(:func:`largest_energy_rise`), and otherwise re-solves to the end time.
+bounds use ``E (1 + ENERGY_SLACK)`` (``W* + E' (1 + ENERGY_SLACK)`` with a potential well).
+:func:`mbs_models.simulate` trusts an early stop only if the solution's energy (above the well's floor)
+rose by no more than that fraction anywhere in the simulated window (:func:`largest_energy_rise`), and
+otherwise re-solves to the end time.
 """
 
 from __future__ import annotations
@@ -60,6 +77,7 @@ import math
 from typing import Iterable
 
 import numpy as np
+from scipy.optimize import brentq
 
 from ..elements.connector import GROUND
 from ..errors import SceneError
@@ -115,7 +133,7 @@ class _QuadraticForm:
         n = len(mechanism.bodies)
         K = np.zeros((n, n))
         for connector in mechanism.connectors:
-            k = connector.linear_stiffness
+            k = connector.linear_stiffness if connector.quadratic_potential else 0.0
             if k > 0:
                 g = mechanism.direction(connector)
                 K += k * np.outer(g, g)
@@ -132,6 +150,166 @@ class _QuadraticForm:
             return math.inf
         inside = components[self._keep]
         return 2.0 * float(np.sum(inside * inside / self._values[self._keep]))
+
+
+class PotentialWell:
+    """The potential well ``W(x) = sum_c U_c(s_c x)`` of one body b (module docstring): its connectors to the
+    ground whose potential is not a quadratic form, and its contacts with the ground; ``s_c = +1`` for
+    ground -> b (``d = x``), -1 for b -> ground (``d = -x``).  W is convex; ``W'(x) = sum_c s_c F_c(s_c x)``,
+    each connector's force at rest.
+
+    :meth:`of` returns None for a scene without such a connector, and a well with :attr:`minimum` ``-inf``
+    (no bound at all) where one exists but no well can be formed or W has no minimum.
+    """
+
+    #: Largest |x| (m) searched for a minimum or a sublevel end: beyond it the well has no bound.
+    REACH = 1e6
+
+    def __init__(self, mechanism: Mechanism, general: list):
+        self.body = None
+        self.members: list = []
+        self.minimum = -math.inf
+        ends = {c.b if c.a == GROUND else c.a for c in general}
+        if any(GROUND not in (c.a, c.b) for c in general) or len(ends) != 1:
+            return
+        body = ends.pop()
+        self.body = mechanism.body_index[body]
+        self.members = general + [c for c in mechanism.contacts if {c.a, c.b} == {GROUND, body}]
+        self.signs = [1.0 if c.a == GROUND else -1.0 for c in self.members]
+        low, high = -math.inf, math.inf
+        for c, s in zip(self.members, self.signs):
+            d_low, d_high = c.coordinate_range
+            low, high = (max(low, d_low), min(high, d_high)) if s > 0 else (max(low, -d_high), min(high, -d_low))
+        self.domain = (low, high)
+        self._ends: dict[float, tuple[float, float]] = {}   # side -> (excess, end) of the last call
+        found = self._minimise()
+        if found is not None:
+            self.argmin, self.minimum = found
+            self._ends = {-1.0: (0.0, self.argmin), 1.0: (0.0, self.argmin)}
+
+    @classmethod
+    def of(cls, mechanism: Mechanism) -> "PotentialWell | None":
+        general = [c for c in mechanism.connectors
+                   if c.stores_energy and not c.is_contact and not c.quadratic_potential]
+        return cls(mechanism, general) if general else None
+
+    def __contains__(self, connector) -> bool:
+        return any(connector is c for c in self.members)
+
+    def sign(self, connector) -> float:
+        """``s_c``: +1 if the connector's d is x_b, -1 if it is -x_b."""
+        return next(s for c, s in zip(self.members, self.signs) if c is connector)
+
+    def potential(self, x: float) -> float:
+        """W(x) in J."""
+        return sum(c.python_stored_energy(s * x) for c, s in zip(self.members, self.signs))
+
+    def slope(self, x: float) -> float:
+        """W'(x) in N: the members' forces at rest, ``sum s_c F_c(s_c x, 0)``."""
+        return sum(s * c.python_force(s * x, 0.0) for c, s in zip(self.members, self.signs))
+
+    def _towards(self, start: float, direction: float, done) -> tuple[float, float] | None:
+        """(last point where ``done`` is False, first point where it is True) walking from ``start`` in
+        ``direction`` by doubling steps, or towards a domain end in halving gaps; None if never True."""
+        previous, step = start, 1e-9
+        edge = self.domain[1] if direction > 0 else self.domain[0]
+        for _ in range(200):
+            if math.isfinite(edge):
+                x = previous + 0.5 * (edge - previous) if abs(edge - start) <= step else start + direction * step
+            else:
+                x = start + direction * step
+            if abs(x) > self.REACH or x == previous:
+                return None
+            if done(x):
+                return previous, x
+            previous, step = x, 2.0 * step
+        return None
+
+    def _minimise(self) -> tuple[float, float] | None:
+        """(x*, W*): the root of the non-decreasing W' (Brent's method to round-off), None without one."""
+        if not self.domain[0] < 0.0 < self.domain[1]:
+            return None
+        start = 0.0
+        if self.slope(start) == 0.0:
+            return start, self.potential(start)
+        direction = -1.0 if self.slope(start) > 0 else 1.0
+        found = self._towards(start, direction, lambda x: self.slope(x) * direction >= 0.0)
+        if found is None:
+            return None
+        a, b = sorted(found)
+        x = brentq(self.slope, a, b, xtol=1e-300, rtol=4.0 * np.finfo(float).eps, maxiter=500)
+        return x, self.potential(x)
+
+    def end(self, direction: float, excess: float) -> float:
+        """The end (m) of the sublevel interval ``W(x) <= W* + excess`` (J, the energy above the floor) on
+        the side ``direction`` (-1: lo, +1: hi); infinite where W never reaches that level.
+
+        W is convex, so Newton's method started outside the interval (where W >= the level) stays outside
+        and converges to the end from there: the result is a bound, not an estimate.  The start is the
+        previous end on that side when the level fell since (the energy mostly decreases), else the first
+        point outside found by doubling steps from there (or from x*).
+        """
+        if not excess > 0.0:
+            return self.argmin
+        if not math.isfinite(excess):
+            return direction * math.inf
+        last_excess, last = self._ends[direction]
+        if excess == last_excess:
+            return last
+        level = self.minimum + excess
+
+        def above(x: float) -> float:
+            return self.potential(x) - level
+
+        x = last if math.isfinite(last) else self.argmin
+        if not self.domain[0] < x < self.domain[1]:  # the last end was the law's singularity
+            if excess >= last_excess:
+                self._ends[direction] = (excess, x)
+                return x
+            x = self.argmin
+        value = above(x)
+        if value < 0.0:
+            found = self._towards(x, direction, lambda y: above(y) >= 0.0)
+            if found is None:
+                self._ends[direction] = (excess, direction * math.inf)
+                return direction * math.inf
+            x = found[1]
+            if not self.domain[0] < x < self.domain[1]:  # within round-off of the law's singularity
+                self._ends[direction] = (excess, x)
+                return x
+            value = above(x)
+        for _ in range(200):
+            slope = direction * self.slope(x)
+            if not (value > 0.0 and slope > 0.0):
+                break
+            trial = x - direction * value / slope
+            trial_value = above(trial)
+            if trial_value < 0.0:  # converged: round-off put the step inside; the end is a few ulps outward
+                for _ in range(64):
+                    trial = math.nextafter(trial, direction * math.inf)
+                    if above(trial) >= 0.0:
+                        if direction * (x - trial) > 0.0:
+                            x = trial
+                        break
+                break
+            if trial == x:
+                break
+            x, value = trial, trial_value
+        self._ends[direction] = (excess, x)
+        return x
+
+    def interval(self, excess: float) -> tuple[float, float]:
+        """``[lo, hi]`` (m): where ``W(x) <= W* + excess`` (J; see :meth:`end`)."""
+        return self.end(-1.0, excess), self.end(1.0, excess)
+
+    def upper(self, connector, excess: float) -> float:
+        """Bound (m) on a member's d = s x (the upper end of s [lo, hi])."""
+        return self.end(1.0, excess) if self.sign(connector) > 0 else -self.end(-1.0, excess)
+
+    def magnitude(self, connector, excess: float) -> float:
+        """Bound (m) on a member's |d|: ``max(|lo|, |hi|)``."""
+        low, high = self.interval(excess)
+        return max(abs(low), abs(high))
 
 
 class EnergyBounds:
@@ -155,9 +333,13 @@ class EnergyBounds:
         self._groups = []
         for element in mechanism.elements:
             kinetic = [index[b.name] for b in element.bodies]
-            springs = [c for c in element.connectors if c.stores_energy and not c.is_contact]
+            springs = [c for c in element.connectors if c.stores_energy and not c.is_contact and c.quadratic_potential]
             contacts = [c for c in element.connectors if c.is_contact]
-            self._groups.append((kinetic, springs, contacts))
+            general = [c for c in element.connectors
+                       if c.stores_energy and not c.is_contact and not c.quadratic_potential]
+            self._groups.append((kinetic, springs, contacts, general))
+        #: the potential well of a connector whose potential is not a quadratic form (None: there is none)
+        self.well = PotentialWell.of(mechanism)
         self._barrel_coefficient = form.coefficient(np.eye(len(self.masses))[0]) if self.masses else math.inf
         self.contacts = mechanism.contacts
         self._contact_coefficients = [form.coefficient(mechanism.direction(c)) for c in self.contacts]
@@ -198,7 +380,7 @@ class EnergyBounds:
         energy = 0.0
         mechanism = self.mechanism
         half = self._half_masses
-        for kinetic, springs, contacts in self._groups:
+        for kinetic, springs, contacts, general in self._groups:
             if kinetic or springs:
                 part = None
                 for i in kinetic:
@@ -211,7 +393,33 @@ class EnergyBounds:
                 energy += part
             for c in contacts:
                 energy += c.python_elastic(mechanism.relative_at(c, x))
+            for c in general:
+                energy += c.python_stored_energy(mechanism.relative_at(c, x))
         return energy
+
+    # ---------------------------------------------------------------------------- the energy above the floor
+    @property
+    def energy_floor(self) -> float:
+        """A lower bound (J) of the stored energy over all states: 0, or the potential well's minimum W*."""
+        return 0.0 if self.well is None else self.well.minimum
+
+    def with_slack(self, energy: float) -> float:
+        """The energy (J) the bounds are evaluated at: ``E (1 + ENERGY_SLACK)``, or ``W* + (E - W*) (1 +
+        ENERGY_SLACK)`` with a potential well (the integration error scales with the energy above the floor)."""
+        if self.well is None:
+            return energy * (1.0 + ENERGY_SLACK)
+        if not math.isfinite(self.well.minimum):
+            return energy
+        return self.well.minimum + (energy - self.well.minimum) * (1.0 + ENERGY_SLACK)
+
+    def _excess(self, energy: float) -> float:
+        """``E' = E - W*`` (J, >= 0): the bound on every non-negative term of E (``max(E, 0)`` without a well;
+        inf where a nonlinear potential has no well)."""
+        if self.well is None:
+            return max(energy, 0.0)
+        if not math.isfinite(self.well.minimum):
+            return math.inf
+        return max(energy - self.well.minimum, 0.0)
 
     def contact_force(self, contact, x, v) -> float:
         """The force (N) of a contact at the state, with its current onset rate."""
@@ -238,38 +446,59 @@ class EnergyBounds:
         return energy
 
     # ---------------------------------------------------------------------------- bounds
+    def _in_well(self, connector) -> bool:
+        return self.well is not None and connector in self.well
+
     def barrel_displacement(self, energy: float) -> float:
-        """Bound (m) on x_M: the springs' and every recoil stop's; inf without either."""
-        e = max(energy, 0.0)
+        """Bound (m) on x_M: the springs', every recoil stop's and a potential well's; inf without any."""
+        e = self._excess(energy)
         bound = math.sqrt(self._barrel_coefficient * e)
         for stop in self._barrel_stops:
-            bound = min(bound, stop.offset + stop.penetration_bound(e))
+            if not self._in_well(stop):
+                bound = min(bound, stop.offset + stop.penetration_bound(e))
+        if self.well is not None and self.well.body == 0:
+            bound = min(self.well.end(1.0, e), bound)  # (bound is nan for inf * 0: no spring on the barrel, E' = 0)
         return bound
 
     def body_velocity(self, i: int, energy: float) -> float:
         """Bound (m/s) on |v_i|."""
-        return math.sqrt(2.0 / self.masses[i] * max(energy, 0.0))
+        return math.sqrt(2.0 / self.masses[i] * self._excess(energy))
+
+    def velocity_from_own_energy(self, i: int, own: float) -> float:
+        """Bound (m/s) on |v_i| of a free oscillator from its own energy ``own`` (J, >= 0)."""
+        return math.sqrt(2.0 / self.masses[i] * max(own, 0.0))
 
     def contact_coordinate(self, j: int, energy: float) -> float:
-        """Bound (m) on contact ``j``'s relative coordinate d (= x_M - x_m for an absorber) from the springs."""
-        return math.sqrt(self._contact_coefficients[j] * max(energy, 0.0))
+        """Bound (m) on contact ``j``'s relative coordinate |d| (= x_M - x_m for an absorber) from the springs
+        (from its potential well: ``max(|lo|, |hi|)``)."""
+        if self._in_well(self.contacts[j]):
+            return self.well.magnitude(self.contacts[j], self._excess(energy))
+        return math.sqrt(self._contact_coefficients[j] * self._excess(energy))
+
+    def _upper(self, j: int, energy: float) -> float:
+        """Bound (m) on contact ``j``'s d (signed: a well member's upper end of d)."""
+        if self._in_well(self.contacts[j]):
+            return self.well.upper(self.contacts[j], self._excess(energy))
+        return math.sqrt(self._contact_coefficients[j] * self._excess(energy))
 
     def contact_reachable(self, j: int, energy: float) -> bool:
         """Can contact ``j`` (index in :attr:`contacts`) close (p > 0) ever again?"""
-        return math.sqrt(self._contact_coefficients[j] * max(energy, 0.0)) > self.contacts[j].offset
+        return self._upper(j, energy) > self.contacts[j].offset
 
     def penetration(self, j: int, energy: float) -> float:
         """Bound (m) on contact ``j``'s penetration (0 if it cannot close)."""
-        e = max(energy, 0.0)
-        relative = math.sqrt(self._contact_coefficients[j] * e)
+        e = self._excess(energy)
+        relative = self._upper(j, energy)
         contact = self.contacts[j]
         if not relative > contact.offset:
             return 0.0
+        if self._in_well(contact):  # its own potential is part of the well's: the interval bounds it
+            return relative - contact.offset
         return min(contact.penetration_bound(e), relative - contact.offset)
 
     def penetration_rate(self, j: int, energy: float) -> float:
         """Bound (m/s) on contact ``j``'s |p'|."""
-        return math.sqrt(self._rate_coefficients[j] * max(energy, 0.0))
+        return math.sqrt(self._rate_coefficients[j] * self._excess(energy))
 
     def contact_force_bound(self, j: int, energy: float) -> float:
         """Bound (N) on contact ``j``'s force (0 if it cannot close)."""
@@ -280,12 +509,14 @@ class EnergyBounds:
 
     def support_force_bound(self, energy: float) -> float:
         """Bound (N) on |S|: the sum of the force bounds of the connectors touching the ground."""
-        e = max(energy, 0.0)
+        e = self._excess(energy)
         total = 0.0
         contact_index = {id(c): j for j, c in enumerate(self.contacts)}
         for c, coefficient, rate_coefficient in self._ground:
             if c.is_contact:
-                total += self.contact_force_bound(contact_index[id(c)], e)
+                total += self.contact_force_bound(contact_index[id(c)], energy)
+            elif self._in_well(c):  # |d| <= max(|lo|, |hi|) of the well's interval
+                total += c.force_bound(self.well.magnitude(c, e), math.sqrt(rate_coefficient * e), e)
             else:
                 total += c.force_bound(math.sqrt(coefficient * e), math.sqrt(rate_coefficient * e), e)
         return total
@@ -397,7 +628,7 @@ class FinalityTracker:
         if not todo:
             return
         bounds = self.bounds
-        energy = bounds.energy(x, v) * (1.0 + ENERGY_SLACK)
+        energy = bounds.with_slack(bounds.energy(x, v))
         newly = []
         if "max_barrel_displacement" in todo and bounds.barrel_displacement(energy) <= self.max_barrel_position:
             newly.append("max_barrel_displacement")
@@ -421,7 +652,7 @@ class FinalityTracker:
                     _, contacts = bounds._free_oscillators[i]
                     if not any(reachable[bounds.contacts.index(c)] for c in contacts):
                         own = bounds.oscillator_energy(i, x, v) * (1.0 + ENERGY_SLACK)
-                        bound = min(bound, bounds.body_velocity(i, own))
+                        bound = min(bound, bounds.velocity_from_own_energy(i, own))
                 if bound > self.max_velocity[i]:
                     final = False
                     break

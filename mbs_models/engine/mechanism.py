@@ -8,7 +8,7 @@ Exudyn; a new one is built for every solve (contact connectors carry the onset c
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -55,10 +55,24 @@ class Mechanism:
         self.loads: list[Load] = [load for e in self.elements for load in e.loads]
         self.impulses: list[tuple[float, str, float]] = sorted(i for e in self.elements for i in e.impulses)
         self.impulse_element = {(t, body): e.name for e in self.elements for t, body, _ in e.impulses}
+        self._place_bodies()
         self.body_index = {body.name: i for i, body in enumerate(self.bodies)}
         self.connector = {c.name: c for c in self.connectors}
         if not self.bodies or self.bodies[0].name != BARREL:
             raise ValueError("the barrel must be the first body")
+
+    def _place_bodies(self) -> None:
+        """Give the bodies the initial positions the elements impose (a preload holding the barrel in battery:
+        :meth:`~mbs_models.elements.table.Table.initial_positions`); without any, every body stays at x = 0."""
+        positions: dict[str, float] = {}
+        for element in self.elements:
+            positions.update(element.table.initial_positions(self.scene, element.name, self.bodies, self.connectors))
+        if not positions:
+            return
+        for element in self.elements:
+            element.bodies = [replace(b, initial_position=float(positions[b.name])) if b.name in positions else b
+                              for b in element.bodies]
+        self.bodies = [b for e in self.elements for b in e.bodies]
 
     # ------------------------------------------------------------------ views
     @property
@@ -139,14 +153,33 @@ class Mechanism:
             c[self.body_index[connector.a]] -= 1.0
         return c
 
+    def initial_positions(self) -> list[float]:
+        """Body positions (m) at t = 0, in body order."""
+        return [b.initial_position for b in self.bodies]
+
+    def initial_relative(self, connector: Connector) -> float:
+        """``d`` (m) of a connector at t = 0."""
+        return self.relative_at(connector, self.initial_positions())
+
     def initial_stored_energy(self) -> float:
-        """Stored energy (J) at t = 0 (all bodies at x = 0): a contact's initial interference."""
+        """Stored energy (J) at t = 0, at the initial positions: a contact's initial interference, a preload."""
         energy = 0.0
         for connector in self.connectors:
             if connector.stores_energy:
-                energy += float(connector.stored_energy(0.0))
+                energy += float(connector.stored_energy(self.initial_relative(connector)))
         return energy
 
     def initial_energy(self) -> float:
-        """Mechanical energy at t = 0 in J: kinetic + stored (an initial interference)."""
+        """Mechanical energy at t = 0 in J: kinetic + stored (an initial interference, a preload)."""
         return self.scene.initial_kinetic_energy + self.initial_stored_energy()
+
+    def energy_scale(self) -> float:
+        """The scale (J) of the energy-balance errors: the initial kinetic energy plus the magnitude of every
+        initial stored energy.  It is :meth:`initial_energy` unless a potential is negative at t = 0 (a gas
+        spring expanded beyond battery by its preload), where the initial energy may be ~0 while the
+        stored energies are not."""
+        energy = 0.0
+        for connector in self.connectors:
+            if connector.stores_energy:
+                energy += abs(float(connector.stored_energy(self.initial_relative(connector))))
+        return self.scene.initial_kinetic_energy + energy

@@ -473,9 +473,10 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
         work = result.work_history
         energy_error = energy_error - work
         mechanical = mechanical - work  # what never increases once the inputs are counted
-        scale = mechanism.initial_energy() + float(np.max(np.abs(work)))
+        scale = mechanism.energy_scale() + float(np.max(np.abs(work)))
     stability.check_energy_balance(scene, samples.time, energy_error, f"Exudyn {settings.label()}", scale)
-    if stopped and largest_energy_rise(mechanical) > ENERGY_SLACK:
+    floor = tracker.bounds.energy_floor if stopped else 0.0  # the energy's lower bound (a preload's well)
+    if stopped and largest_energy_rise(mechanical - floor) > ENERGY_SLACK:
         # the solution's energy rose by more than the bounds' slack: do not trust the early stop
         result = simulate(scene, end_time, settings, impact_threshold=impact_threshold)
         result.stop_reason = STOP_ENERGY_CHECK

@@ -160,7 +160,7 @@ def estimate_contacts(scene: Scene | Mechanism) -> dict[str, ContactEstimate]:
     for contact in mechanism.contacts:
         n, k = contact.exponent, contact.contact_stiffness
         m_red = _reduced_mass(mechanism, contact)
-        interference = float(contact.stored_energy(0.0))
+        interference = float(contact.stored_energy(mechanism.initial_relative(contact)))
         speed = math.sqrt(v0 ** 2 + 2.0 * interference / m_red)
         bound = ((n + 1.0) * energy / k) ** (1.0 / (n + 1.0))
         p = min(contact.impact_penetration(m_red, speed), bound)
@@ -341,12 +341,14 @@ def check_settings(scene: Scene, settings: SolverSettings, end_time: float) -> N
 def check_energy_balance(scene: Scene, time: np.ndarray, error: np.ndarray, solver_label: str,
                          energy_scale: float | None = None) -> None:
     """Refuse a solve whose energy balance (``error`` in J at ``time``) is off by more than
-    :data:`ENERGY_FAILURE` of the initial energy (``energy_scale`` J where external inputs add energy:
-    the initial energy plus the largest work done): its numbers would be garbage.  Warn (AccuracyWarning)
-    above :data:`ENERGY_WARNING`."""
+    :data:`ENERGY_FAILURE` of the initial energy: its numbers would be garbage.  Warn (AccuracyWarning)
+    above :data:`ENERGY_WARNING`.  ("The initial energy" is :meth:`Mechanism.energy_scale`: the initial
+    kinetic energy plus the magnitude of every initial stored energy, which is the initial energy
+    unless a preload makes a potential negative at t = 0; ``energy_scale`` J where external inputs add
+    energy: that plus the largest work done.)"""
     from ..errors import SimulationError
 
-    energy = max(initial_energy(scene) if energy_scale is None else energy_scale, 1e-300)
+    energy = max(_mechanism(scene).energy_scale() if energy_scale is None else energy_scale, 1e-300)
     relative = np.abs(np.asarray(error, dtype=float)) / energy
     k = int(np.argmax(relative))
     worst = float(relative[k])

@@ -8,8 +8,9 @@ iterates over what the scene has, in assembly order.  A scene built in Python is
 read from TOML (:mod:`mbs_models.scene.io`); errors are :class:`~mbs_models.errors.SceneError` naming
 the key, e.g. ``contact.gap`` or ``absorber.1.mass``.
 
-Sign convention: positions are positive in the recoil direction; every body starts at x = 0, the
-absorbers at rest, the barrel at ``v0`` (:attr:`Scene.initial_velocity`).
+Sign convention: positions are positive in the recoil direction; every body starts at x = 0 (unless a
+preload holds the barrel in battery: :mod:`mbs_models.elements.recuperator`), the absorbers at rest, the
+barrel at ``v0`` (:attr:`Scene.initial_velocity`).
 """
 
 from __future__ import annotations

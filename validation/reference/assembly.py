@@ -8,13 +8,18 @@ error: the reference would silently leave an effect out.
 
 from __future__ import annotations
 
+from dataclasses import replace
+from typing import Callable
+
 from .model import BARREL, AbsorberRole, Body, Connector, Impulse, Load, Model, ReferenceModelError
 from .terms import TERMS
 
 
 class ModelBuilder:
     """What the terms add while a scene is read: bodies, connectors, absorbers and stops (by name), external
-    loads and velocity jumps, and the shot times of a burst (None unless a term sets them)."""
+    loads and velocity jumps, the shot times of a burst (None unless a term sets them), and finishers:
+    functions of the complete builder, run before the model is made (a preload's initial state needs every
+    connector), that may set bodies' initial positions (:attr:`positions`, m)."""
 
     def __init__(self, scene):
         self.scene = scene
@@ -25,6 +30,8 @@ class ModelBuilder:
         self.loads: list[Load] = []
         self.impulses: list[Impulse] = []
         self.shot_times: tuple[float, ...] | None = None
+        self.positions: dict[str, float] = {}
+        self.finishers: list[Callable] = []
 
     def add_body(self, body: Body) -> None:
         self.bodies.append(body)
@@ -50,9 +57,18 @@ class ModelBuilder:
         """The times (s) the shots of a burst fire, from 0 (the per-shot outputs and time events)."""
         self.shot_times = tuple(float(t) for t in times)
 
+    def add_finisher(self, finisher: Callable) -> None:
+        """``finisher(builder)`` runs once every table is read, before the model is made."""
+        self.finishers.append(finisher)
+
     def model(self) -> Model:
-        """The model: the barrel first, then the other bodies in the order they were added."""
-        bodies = sorted(self.bodies, key=lambda b: b.name != BARREL)
+        """The model: the barrel first, then the other bodies in the order they were added, at the initial
+        positions the finishers set (0 for the others)."""
+        for finisher in self.finishers:
+            finisher(self)
+        bodies = [replace(b, initial_position=float(self.positions[b.name])) if b.name in self.positions else b
+                  for b in self.bodies]
+        bodies = sorted(bodies, key=lambda b: b.name != BARREL)
         return Model(getattr(self.scene, "name", ""), bodies, self.connectors, self.absorbers, self.stops,
                      self.loads, self.impulses, self.shot_times)
 

@@ -23,6 +23,18 @@ External inputs (loads, shots) add energy: the bounds hold only once the last of
 (:attr:`Model.last_input_time`; the solver checks from then on), and not at all under a load that never
 ends (a constant load: :attr:`Finality.enabled` is False).  The maxima are observed over the whole run.
 
+**A nonlinear potential** (``nonlinear_potential``: the recuperator's gas spring, ``U(d) = integral_0^d F``
+with ``F > 0``, negative for d < 0) breaks "every term of E is >= 0".  Such a connector between the
+ground and a body, with that body's contacts with the ground (its stops), makes a **potential well**
+``W(x) = sum_c U_c(+-x)`` of the body's position (``+x`` for ground -> body, ``-x`` for body -> ground): every
+``U_c`` is convex (its force at rest never decreases with d), so W is, with its minimum ``W*`` where the
+forces at rest balance.  All other terms of E and ``W - W*`` are >= 0, so everything above holds with
+``E' = E - W*`` in place of E, and ``W(x) <= W* + E'`` confines x to an interval ``[lo, hi]`` (found by
+Brent's method between doubling brackets; ``hi < V0/A`` since the gas spring's U diverges there), which
+bounds the body's position, each member's |d| (``max(|lo|, |hi|)``, hence its force) and each member
+contact's penetration (from the upper end of its d).  The slack then applies to E'.  A nonlinear potential
+anywhere else, or a well without a minimum, gives no bound at all.
+
 A metric is final once its observed maximum (a lower bound of the true one: values of the solution at the
 solver's step points) reaches the bound of everything later: ``max_barrel_displacement`` (x of the barrel),
 ``max_absorber_velocity`` (every absorber's v), ``peak_contact_force`` (every contact's force: absorbers
@@ -35,6 +47,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy.optimize import brentq
 
 from .model import GROUND, Model, Mode
 
@@ -64,6 +77,95 @@ def check_names(names) -> tuple[str, ...]:
     return tuple(n for n in METRICS if n in names)
 
 
+class PotentialWell:
+    """The well ``W(x)`` of a nonlinear potential and its body's stops (module docstring).
+
+    Attributes: ``body`` (index, None if no well can be formed), ``members`` (connectors), ``floor`` (W*, J;
+    -inf without a well), ``x_star`` (m).
+    """
+
+    #: |x| (m) beyond which no bracket is sought (no bound).
+    FAR = 1e6
+
+    def __init__(self, model: Model):
+        gas = [c for c in model.connectors if c.nonlinear_potential]
+        self.body, self.members, self.floor, self.x_star = None, [], -math.inf, math.nan
+        bodies = {c.body_b if c.a == GROUND else c.body_a for c in gas}
+        if not gas or any(GROUND not in (c.a, c.b) for c in gas) or len(bodies) != 1:
+            return
+        self.body = bodies.pop()
+        self.members = gas + [c for c in model.contacts
+                              if GROUND in (c.a, c.b) and self.body in (c.body_a, c.body_b)]
+        self.sign = {c.index: 1.0 if c.a == GROUND else -1.0 for c in self.members}
+        # x where every member's law is defined: d = s x < d_limit
+        self.x_high = min([c.d_limit for c in self.members if self.sign[c.index] > 0], default=math.inf)
+        self.x_low = max([-c.d_limit for c in self.members if self.sign[c.index] < 0], default=-math.inf)
+        self._cache: dict = {}
+        root = self._root(lambda x: sum(self.sign[c.index] * c.static_force(self.sign[c.index] * x)
+                                        for c in self.members), 0.0)
+        if root is not None:
+            self.x_star = root
+            self.floor = self.W(root)
+
+    def W(self, x: float) -> float:
+        """The well's potential (J) at the body's position x (m)."""
+        return float(sum(c.stored_energy(self.sign[c.index] * x) for c in self.members))
+
+    def _bracket(self, f, start: float, side: float):
+        """A point beyond ``start`` on ``side`` where ``f >= 0`` (f < 0 at start): doubling steps, halving the
+        way to a finite end of the domain; None if there is none."""
+        end = self.x_high if side > 0 else self.x_low
+        gap = 1e-9
+        x_prev = start
+        while True:
+            if math.isfinite(end) and side * (end - start) <= gap:
+                x = 0.5 * (x_prev + end)
+                if x == x_prev or x == end:
+                    return None
+            else:
+                x = start + side * gap
+                if abs(x) > self.FAR:
+                    return None
+            if f(x) >= 0.0:
+                return x_prev, x
+            x_prev, gap = x, 2.0 * gap
+
+    def _root(self, slope, start: float):
+        """The root of the non-decreasing ``slope`` (the balance of the forces at rest), None without one."""
+        value = slope(start)
+        if value == 0.0:
+            return start
+        side = -1.0 if value > 0.0 else 1.0
+        found = self._bracket(lambda x: side * slope(x), start, side)
+        if found is None:
+            return None
+        return brentq(slope, min(found), max(found), xtol=1e-300, rtol=4.0 * np.finfo(float).eps, maxiter=500)
+
+    def end(self, excess: float, side: float) -> float:
+        """The end (m) on ``side`` (-1, +1) of ``W(x) <= W* + excess`` (J): the outermost float at or outside
+        the root (a bound); +-inf if W never gets there."""
+        if not excess > 0.0:
+            return self.x_star
+        if not math.isfinite(excess):
+            return side * math.inf
+        key = (excess, side)
+        if key not in self._cache:
+            level = self.floor + excess
+            found = self._bracket(lambda x: self.W(x) - level, self.x_star, side)
+            if found is None:
+                value = side * math.inf if not math.isfinite(self.x_high if side > 0 else self.x_low) else \
+                    (self.x_high if side > 0 else self.x_low)
+            else:
+                value = brentq(lambda x: self.W(x) - level, min(found), max(found), xtol=1e-300,
+                               rtol=4.0 * np.finfo(float).eps, maxiter=500)
+                while self.W(value) < level:
+                    value = math.nextafter(value, side * math.inf)
+            if len(self._cache) > 64:
+                self._cache.clear()
+            self._cache[key] = value
+        return self._cache[key]
+
+
 class EnergyBounds:
     """The bounds of the module docstring for one model; every method takes the energy E (J) now."""
 
@@ -84,11 +186,36 @@ class EnergyBounds:
         self._ground_connectors = [c for c in model.connectors if c.support_sign != 0]
         # bodies whose connectors all go to the ground but for contacts with other bodies
         self._own_energy = {}
+        #: the potential well of a nonlinear potential (None without one)
+        self.well = PotentialWell(model) if any(c.nonlinear_potential for c in model.connectors) else None
         for i in range(nb):
             touching = [c for c in model.connectors if i in (c.body_a, c.body_b)]
-            if all(c.support_sign != 0 or c.is_contact for c in touching):
+            if all(c.support_sign != 0 or c.is_contact for c in touching) and \
+                    (self.well is None or i != self.well.body):
                 self._own_energy[i] = ([c for c in touching if c.support_sign != 0],
                                        [c for c in touching if c.support_sign == 0])
+
+    @property
+    def floor(self) -> float:
+        """A lower bound (J) of the stored energy: 0, or the well's W*."""
+        return 0.0 if self.well is None else self.well.floor
+
+    def with_slack(self, energy: float) -> float:
+        """``E (1 + ENERGY_SLACK)``; with a well ``W* + (E - W*) (1 + ENERGY_SLACK)`` (J)."""
+        if self.well is None:
+            return energy * (1.0 + ENERGY_SLACK)
+        if math.isinf(self.well.floor):
+            return energy
+        return self.well.floor + (energy - self.well.floor) * (1.0 + ENERGY_SLACK)
+
+    def _above_floor(self, energy: float) -> float:
+        """``E' = E - W*`` (J): what bounds each non-negative term; E itself without a well."""
+        if self.well is None:
+            return energy
+        return math.inf if math.isinf(self.well.floor) else max(energy - self.well.floor, 0.0)
+
+    def _member(self, c) -> bool:
+        return self.well is not None and any(c is m for m in self.well.members)
 
     def direction(self, connector) -> np.ndarray:
         """c with ``d = c.q``: ``e_b - e_a`` (the ground has no coordinate)."""
@@ -115,12 +242,19 @@ class EnergyBounds:
     def connector_bounds(self, energy: float) -> list[tuple[float, float, float]]:
         """Per connector: (``|d|`` m, ``|d'|`` m/s, penetration m -- 0 if a contact cannot close, else
         the smaller of the quadratic-form and own-potential bounds; inf for non-contacts)."""
+        energy = self._above_floor(energy)
         out = []
         for c, form in zip(self.model.connectors, self._connector_form):
             d = self._sqrt2(energy, form)
             rate = self._sqrt2(energy, c.inverse_reduced_mass)
             p = math.inf
-            if c.is_contact:
+            if self._member(c):  # from the well's interval: |d| <= max(|lo|, |hi|), d <= s-end
+                lo, hi = self.well.end(energy, -1.0), self.well.end(energy, 1.0)
+                d = max(abs(lo), abs(hi))
+                if c.is_contact:
+                    top = hi if self.well.sign[c.index] > 0 else -lo
+                    p = top - c.offset if top > c.offset else 0.0
+            elif c.is_contact:
                 p = 0.0 if d <= c.offset else min(c.penetration_bound(energy), d - c.offset)
             out.append((d, rate, p))
         return out
@@ -136,9 +270,13 @@ class EnergyBounds:
         model = self.model
         per_connector = self.connector_bounds(energy)
         forces = [c.force_bound(d, rate, p) for c, (d, rate, p) in zip(model.connectors, per_connector)]
+        energy = self._above_floor(energy)
         x = [self._sqrt2(energy, form) for form in self._body_form]
         for i, c in self._ground_contacts:
-            x[i] = min(x[i], c.offset + c.penetration_bound(energy))
+            if not self._member(c):
+                x[i] = min(x[i], c.offset + c.penetration_bound(energy))
+        if self.well is not None and self.well.body is not None:
+            x[self.well.body] = min(x[self.well.body], self.well.end(energy, 1.0))
         v = [self._sqrt2(energy, 1.0 / m) for m in model.masses]
         reachable = [p > 0 for (_, _, p) in per_connector]
         if y is not None and not continuous:
@@ -221,7 +359,7 @@ class Finality:
         whose impact is not decided yet).  ``continuous`` leaves out the own-energy refinement (see
         :meth:`EnergyBounds.bounds`)."""
         names = self.requested if names is None else names
-        energy = float(self.model.mechanical_energy(y)) * (1.0 + ENERGY_SLACK)
+        energy = self.energy_bounds.with_slack(float(self.model.mechanical_energy(y)))
         b = self.energy_bounds.bounds(energy, y, continuous)
         out = {}
         for name in names:
@@ -232,7 +370,7 @@ class Finality:
 
     def item_gaps(self, y, mode: Mode) -> dict[tuple, float]:
         """Margin of every item not yet final (as :meth:`gaps`, item by item)."""
-        energy = float(self.model.mechanical_energy(y)) * (1.0 + ENERGY_SLACK)
+        energy = self.energy_bounds.with_slack(float(self.model.mechanical_energy(y)))
         b = self.energy_bounds.bounds(energy, y)
         return {item: self._margin(item, b, mode) for items in self.items.values() for item in items
                 if item not in self.final_items}

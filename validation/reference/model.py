@@ -1,7 +1,8 @@
 """The reference's mechanism: bodies, connectors, modes and the right-hand side, effect-free.
 
 Written from DESIGN.md ("Bodies and connectors").  Every body moves on the recoil axis (x positive in
-the recoil direction, 0 at the start).  Every force is a :class:`Connector` between points ``a`` and
+the recoil direction, 0 at battery; a body starts at its ``initial_position``: 0 unless a preload holds
+the barrel against its battery stop, DESIGN.md "Initial state").  Every force is a :class:`Connector` between points ``a`` and
 ``b`` (bodies, or the ground :data:`GROUND`) with relative coordinate ``d = x_b - x_a`` (m) and rate
 ``d' = v_b - v_a`` (m/s); its force ``F`` (N) pushes ``b`` towards -x and ``a`` towards +x::
 
@@ -61,11 +62,13 @@ class ReferenceModelError(ValueError):
 
 @dataclass(frozen=True)
 class Body:
-    """A mass on the recoil axis: ``name``, ``mass`` (kg), ``initial_velocity`` (m/s); it starts at x = 0."""
+    """A mass on the recoil axis: ``name``, ``mass`` (kg), ``initial_velocity`` (m/s), ``initial_position`` (m,
+    0 unless a preload holds the body elsewhere at t = 0)."""
 
     name: str
     mass: float
     initial_velocity: float = 0.0
+    initial_position: float = 0.0
 
 
 def _difference(ia: int | None, ib: int | None) -> Callable:
@@ -104,7 +107,10 @@ class Connector:
     * ``stores_energy`` -- it has a potential U(d);
     * ``injects_energy`` -- its law can add energy (the early stop has no bound then);
     * ``classify_pass`` -- 0: no discrete state; 1: decided on the accelerations *without* its own force
-      (contacts); 2: decided on the accelerations of the classified mode (velocity-sign switches).
+      (contacts); 2: decided on the accelerations of the classified mode (velocity-sign switches);
+    * ``nonlinear_potential`` -- its potential is neither a linear spring's ``k d^2 / 2`` nor >= 0 (the
+      recuperator's gas spring): the early stop bounds it together with its body's stops
+      (:mod:`validation.reference.finality`); ``d_limit`` (m) is the largest d where its law is defined.
     """
 
     is_contact = False
@@ -112,6 +118,8 @@ class Connector:
     stores_energy = False
     classify_pass = 0
     injects_energy = False
+    nonlinear_potential = False
+    d_limit = float("inf")
 
     def __init__(self, name: str, a: str, b: str):
         if a == b:
@@ -170,6 +178,11 @@ class Connector:
     def stored_energy(self, d):
         """Stored (potential) energy U(d) in J (numpy or float)."""
         return 0.0 * d
+
+    def static_force(self, d: float) -> float:
+        """The force (N) at rest (d' = 0) at ``d`` (m, a float): ``dU/dd`` of a connector with a potential, 0 for
+        a damper (the static equilibrium at t = 0, the early stop's potential well)."""
+        return 0.0
 
     # ------------------------------------------------------------------ modes (overridden by switching laws)
     def provisional(self, s: list, previous):
@@ -451,9 +464,11 @@ class Model:
 
     # ------------------------------------------------------------------ state
     def initial_state(self) -> np.ndarray:
-        """y(0): every body at 0 with its initial velocity, no dissipated energy."""
+        """y(0): every body at its initial position (0 but for a preload's hold) with its initial velocity, no
+        dissipated energy."""
         y = np.zeros(self.n_states)
         for i, body in enumerate(self.bodies):
+            y[2 * i] = body.initial_position
             y[2 * i + 1] = body.initial_velocity
         return y
 

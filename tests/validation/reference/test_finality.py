@@ -144,10 +144,19 @@ def test_early_stopped_reference_gives_the_full_runs_metrics(key, requested):
                          ids=["all", "x", "S"])
 @pytest.mark.parametrize("key", [*NEW, *EVERY])
 def test_early_stop_with_several_absorbers_every_element_and_every_law(key, requested, new_scenes):
-    early = _check(new_scenes[key], requested)
+    scene = new_scenes[key]
+    early = _check(scene, requested)
     forever = not math.isfinite(early.model.last_input_time)  # a load acting for ever: no bound
-    expected = "end_time_no_energy_bound" if forever else "metrics_final"
-    assert early.stop_reason == expected, (key, requested)
+    if forever:
+        assert early.stop_reason == "end_time_no_energy_bound", (key, requested)
+        return
+    if early.stop_reason != "metrics_final" and "impacts" in requested:
+        # a contact loaded above the impact threshold at rest (a preload held on its stop) keeps an episode
+        # going for ever: the impacts cannot be final, the other metrics must be
+        full = _full(scene)
+        assert any(full.connector_force(name, END) > full.impact_threshold for name in full.contacts), key
+        early = _check(scene, tuple(name for name in requested if name != "impacts"))
+    assert early.stop_reason == "metrics_final", (key, requested)
 
 
 @pytest.mark.parametrize("key", ["two-absorbers-every-element", "ii-gonthier", "i-kelvin-voigt",
@@ -196,14 +205,16 @@ def assert_bounds_hold(result, end):
     t = np.linspace(model.last_input_time, end, 6001)
     y = result.state(t)
     energy = model.mechanical_energy(y)
+    floor = bounds.floor  # 0, or the minimum of a preload's potential well: the energy's lower bound
     rise = np.maximum.accumulate(energy[::-1])[::-1] - energy
-    assert np.all(rise <= 1e-9 * energy + 1e-12), "the reference's energy must never increase"
+    assert np.all(rise <= 1e-9 * (energy - floor) + 1e-12), "the reference's energy must never increase"
 
     def later(values):
         return np.maximum.accumulate(np.asarray(values)[::-1])[::-1]
 
-    computed = [bounds.bounds(float(e) * (1 + 1e-9), y[:, k]) for k, e in enumerate(energy)]
-    per_connector = [bounds.connector_bounds(float(e) * (1 + 1e-9)) for e in energy]
+    slack = [floor + (float(e) - floor) * (1 + 1e-9) for e in energy]
+    computed = [bounds.bounds(e, y[:, k]) for k, e in enumerate(slack)]
+    per_connector = [bounds.connector_bounds(e) for e in slack]
     checks = {"x_barrel": (y[0], [b["x"][0] for b in computed]),
               "support": (np.abs(result.support_force(t)), [b["support"] for b in computed])}
     for i, body in enumerate(result.bodies):

@@ -68,10 +68,11 @@ def test_names_follow_design(solved, scenes, design_connectors):
     others = other_contacts(scene)
     assert others and set(r.contacts) == {"front_contact", "rear_contact"} | others
     assert [m.name for m in r.absorber_metrics] == ["front", "rear"] and set(r.stop_metrics) == others
-    # every connector of this scene but the pure spring damps (all its contact laws do); the springs (the recoil
-    # spring, the absorbers' actuators) and the contacts store energy, nothing else (DESIGN.md, "Energy")
-    assert set(r.dissipated_energy) == set(r.connectors) - {"recoil_spring"}
-    assert set(r.stored_energy(0.1)) == {"recoil_spring", "front_damper", "rear_damper"} | set(r.contacts)
+    # the pure spring only stores energy, the pure damper only dissipates it, every contact law does both;
+    # every connector does one or the other
+    dissipating, storing = set(r.dissipated_energy), set(r.stored_energy(0.1))
+    assert "recoil_spring" in storing - dissipating and "recoil_damper" in dissipating - storing
+    assert set(r.contacts) <= dissipating & storing and dissipating | storing == set(r.connectors)
     assert set(r.kinetic_energy(0.1)) == {"barrel", "front", "rear"}
     one = solved("ii")
     assert one.bodies == ("barrel", "absorber") and one.connectors[-2:] == ("absorber_damper", "contact")
@@ -150,10 +151,13 @@ def test_energy_balance_closes_part_by_part(key, solved, scenes):
     work = sum(r.work_history(t).values(), 0.0 * t)  # the work of a burst's later shots and of loads (gravity)
     total = total - work
     np.testing.assert_allclose(total, r.energy_balance(t), rtol=1e-13)
-    assert r.initial_energy == pytest.approx(0.5 * scenes[key].barrel.mass * scenes[key].initial_velocity ** 2,
-                                             rel=1e-15)
+    # the barrel alone moves at t = 0; what is stored then (a preload held in battery) is part of the initial energy
+    assert r.kinetic_energy(0.0)["barrel"] == pytest.approx(0.5 * scenes[key].barrel.mass
+                                                            * scenes[key].initial_velocity ** 2, rel=1e-15)
+    assert r.initial_energy == pytest.approx(sum(r.kinetic_energy(0.0).values())
+                                             + sum(r.stored_energy(0.0).values()), rel=1e-15)
     # relative to the energy that flows through the mechanism: the initial energy and the largest work done
-    assert np.max(np.abs(total - r.initial_energy)) < 1e-7 * (r.initial_energy + np.max(np.abs(work)))
+    assert np.max(np.abs(total - r.initial_energy)) < 1e-7 * (abs(r.initial_energy) + np.max(np.abs(work)))
     for name, history in r.dissipated_energy_history(t).items():
         assert np.all(np.diff(history) >= -1e-9 * r.initial_energy), name  # every connector only dissipates
 
@@ -213,6 +217,9 @@ def test_contact_episodes_and_onsets(solved):
         assert contact.impacts == [e for e in contact.episodes if e.peak_force > 1000.0]
         c = r.model.connector(name)
         for time, v_minus in contact.onsets:  # onset: p = 0 turning positive at the rate v-
+            if time == 0.0 and c.d_of(r.state(0.0)) - c.offset > 0:  # an initial interference (a preload's hold)
+                assert v_minus == max(c.rate_of(r.state(0.0)), 0.0)
+                continue
             assert abs(c.d_of(r.state(time)) - c.offset) < 1e-12
             assert c.rate_of(r.state(time)) == pytest.approx(v_minus, rel=1e-9, abs=1e-12)
         assert len(contact.onsets) >= len(contact.episodes)

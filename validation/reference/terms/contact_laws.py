@@ -208,6 +208,11 @@ class ContactConnector(Connector):
         n = self.law.exponent
         return self.law.stiffness * np.maximum(d - self.offset, 0.0) ** (n + 1.0) / (n + 1.0)
 
+    def static_force(self, d: float) -> float:
+        """The force at rest (p' = 0): ``k max(p, 0)^n`` (N), every law (the damping terms vanish)."""
+        p = d - self.offset
+        return self.law.stiffness * p ** self.law.exponent if p > 0.0 else 0.0
+
     # ------------------------------------------------------------------ modes
     def _episode(self, rate: float, previous: ContactMode | None) -> tuple[float, float]:
         """(factor, v-) of the episode going on: the previous segment's, or a new one with v- = max(p', 0)."""

@@ -4,7 +4,7 @@ With ``d = x_b - x_a`` (m) and ``d' = v_b - v_a`` (m/s) (DESIGN.md, "Bodies and 
 
 * force ``F = k d + c d'`` (N), k in N/m, c in N s/m;
 * stored energy ``U = k d^2 / 2`` (J); dissipated power ``F d' - dU/dt = c d'^2`` (W);
-* ``dF/dt = k d' + c d''``;
+* ``dF/dt = k d' + c d''``; at rest ``F = k d``;
 * energy bounds: the spring enters the quadratic form with ``k``; ``|F| <= k |d|_max + c |d'|_max``.
 """
 
@@ -44,6 +44,10 @@ class LinearSpringDamper(Connector):
     def stored_energy(self, d):
         """U = k d^2 / 2 (J)."""
         return 0.5 * self.stiffness * d ** 2
+
+    def static_force(self, d: float) -> float:
+        """k d (N)."""
+        return self.stiffness * d
 
     @property
     def linear_stiffness(self) -> float:
