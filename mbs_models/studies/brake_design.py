@@ -144,20 +144,35 @@ class Comparison:
         return {"recoil_length_asked": self.design.recoil_length,
                 "constant_resistance": self.design.resistance,
                 "designed": {"recoil_length": self.designed.max_barrel_displacement,
-                             "peak_support_force": self.designed.peak_support_force},
+                             "peak_support_force": self.designed.peak_support_force,
+                             "peak_support_force_in_recoil": peak_support_force_in_recoil(self.designed)},
                 "linear_damper": {"recoil_length": self.linear.max_barrel_displacement,
                                   "peak_support_force": self.linear.peak_support_force,
+                                  "peak_support_force_in_recoil": peak_support_force_in_recoil(self.linear),
                                   "recoil": self.linear.scene.recoil_damper.recoil,
                                   "counter_recoil": self.linear.scene.recoil_damper.counter_recoil},
                 "resistance_flatness_over_90_percent": self.flatness,
                 "strokes": self.design.strokes.tolist(), "orifice_areas": self.design.areas.tolist()}
 
 
+def peak_support_force_in_recoil(result) -> float:
+    """The largest |support force| (N, samples) from t = 0 to the maximum displacement: the recoil stroke
+    alone (the peak over a run may come later, when the barrel returns onto its battery buffer)."""
+    end = int(np.searchsorted(result.time, result.time_of_max_barrel_displacement))
+    return float(np.max(np.abs(result.support_force[:end + 1])))
+
+
 def recoil_stroke(result) -> tuple[np.ndarray, np.ndarray]:
-    """(x m, resistance -M a N) of the barrel from t = 0 to its maximum displacement."""
+    """(x m, resistance N) of the barrel from t = 0 to its maximum displacement: ``-M a`` plus the external
+    loads on the barrel that are inputs (the breech force), i.e. what the mechanism and gravity resist with."""
     end = int(np.searchsorted(result.time, result.time_of_max_barrel_displacement))
     mass = result.scene.barrel.mass
-    return result.barrel_position[:end + 1], -mass * result.barrel_acceleration[:end + 1]
+    t = result.time[:end + 1]
+    resistance = -mass * result.barrel_acceleration[:end + 1]
+    for load in Mechanism(result.scene).loads:
+        if load.body == BARREL and load.needs_user_function:
+            resistance = resistance + load.force(t)
+    return result.barrel_position[:end + 1], resistance
 
 
 def resistance_flatness(result, resistance: float, recoil_length: float) -> float:
@@ -203,14 +218,15 @@ def plot_comparison(comparison: Comparison):
     for result, label, style in ((comparison.designed, "designed brake (constant resistance)", "-"),
                                  (comparison.linear, f"linear damper x {comparison.damper_scale:.3g}", "--")):
         x, r = recoil_stroke(result)
-        left.plot(1e3 * x, r / 1e3, style, label=f"{label}: peak support {result.peak_support_force / 1e3:.2f} kN")
+        left.plot(1e3 * x, r / 1e3, style, label=f"{label}: peak support {result.peak_support_force / 1e3:.2f} kN "
+                                                 f"({peak_support_force_in_recoil(result) / 1e3:.2f} kN in recoil)")
         right.plot(result.time, result.support_force / 1e3, style, label=label)
     left.axhline(comparison.design.resistance / 1e3, color="grey", lw=0.8, ls=":",
                  label=f"R = M v0^2 / (2 L) = {comparison.design.resistance / 1e3:.2f} kN")
     left.set_xlabel("barrel displacement (mm)")
     left.set_ylabel("resistance to recoil (kN)")
     left.set_title(f"recoil length {1e3 * comparison.designed.max_barrel_displacement:.1f} mm")
-    left.legend(fontsize=8)
+    left.legend(fontsize=7, loc="lower center")
     right.set_xlabel("time (s)")
     right.set_ylabel("support force (kN)")
     right.set_title("force on the mount")
