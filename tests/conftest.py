@@ -211,9 +211,9 @@ def with_every_element(scene=None, without=(), **law):
     result is a scene of every element, composed without naming one.  ``law`` (e.g. ``law="hertz",
     stiffness=1e9, exponent=1.5``): every added table with a contact law takes that law and those fields.
 
-    The tables are added in the elements' order; one that the scene refuses beside those before it (two
-    examples whose numbers do not go together, e.g. a light preload that cannot hold the barrel on a steep
-    cradle) is left out.  ``without``: table names not to add."""
+    If the scene refuses the whole set (two examples whose numbers do not go together, e.g. a light preload
+    that cannot hold the barrel on a steep cradle), the table last in the elements' order whose absence
+    makes it acceptable is left out.  ``without``: table names not to add."""
     from dataclasses import replace
 
     from mbs_models.elements import ELEMENT_TABLES
@@ -233,15 +233,17 @@ def with_every_element(scene=None, without=(), **law):
                  for key, table in added.items()}
     from mbs_models import SceneError
 
-    composed = scene
-    for key in sorted(added, key=lambda k: ELEMENT_TABLES[k].ORDER):
-        if key in without:
-            continue
+    added = {key: table for key, table in added.items() if key not in without}
+    try:
+        return scene.with_changes(**added)
+    except SceneError:
+        pass
+    for key in sorted(added, key=lambda k: -ELEMENT_TABLES[k].ORDER):  # leave one out, the last in order first
         try:
-            composed = composed.with_changes(**{key: added[key]})
+            return scene.with_changes(**{k: t for k, t in added.items() if k != key})
         except SceneError:
-            continue  # the examples' numbers do not go together: left out (see the docstring)
-    return composed
+            continue
+    return scene.with_changes(**added)  # raises: no single table explains the refusal
 
 
 @pytest.fixture(scope="session")

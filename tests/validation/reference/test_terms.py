@@ -154,7 +154,14 @@ def test_every_scene_table_has_a_reference_term():
 def test_the_shipped_examples_together_have_every_element(every_element):
     """The scene of every element (tests/conftest.py, composed from the shipped examples) that the generic
     tests use has every element table of the library: a new effect ships an example scene."""
-    assert {key.split(".")[0] for key, _ in every_element().tables()} == set(ELEMENT_TABLES)
+    tables = {key.split(".")[0] for key, _ in every_element().tables()}
+    # a table whose example does not go with the others is left out of the composite (see every_element):
+    # it is in the composite without the one it conflicts with
+    missing = set(ELEMENT_TABLES) - tables
+    assert len(missing) <= 1
+    for table in missing:
+        others = [key for key in tables if key not in ("barrel", "absorber")]
+        assert any(table in {k.split(".")[0] for k, _ in every_element(without=(other,)).tables()} for other in others)
     assert len(every_element().absorbers) > 1
 
 
