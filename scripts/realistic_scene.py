@@ -20,9 +20,8 @@ sys.path.insert(0, str(ROOT))
 
 from mbs_models import load_scene, scene_to_toml, simulate  # noqa: E402
 from mbs_models.elements.firing import Burst  # noqa: E402
-from mbs_models.engine.mechanism import Mechanism  # noqa: E402
 from mbs_models.results.plotting import save_figure  # noqa: E402
-from mbs_models.studies.brake_design import compare_with_linear_damper, plot_comparison  # noqa: E402
+from mbs_models.studies.brake_design import compare_with_linear_damper, plot_comparison, recoil_stroke  # noqa: E402
 
 RECOIL_LENGTH = 0.30  # m
 BURST = Burst(shots=3, interval=2.5)  # s: the barrel is back in battery ~2.2 s after a shot
@@ -46,8 +45,6 @@ def figures(scene, comparison, out: Path) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    import numpy as np
-
     result = simulate(scene, 7.5)
     fig, axes = plt.subplots(2, 2, figsize=(11, 7))
     t = result.time
@@ -61,11 +58,9 @@ def figures(scene, comparison, out: Path) -> None:
         ax.set_xlabel("time (s)")
         for shot in result.shots:
             ax.axvline(shot["time"], color="grey", lw=0.6, ls=":")
-    end = int(np.searchsorted(t, result.shots[0]["time_of_max_barrel_displacement"]))
-    after_pulse = t[:end + 1] > scene.firing.pulse.table[0][-1]  # the breech force accelerates, not resists
-    breech = Mechanism(scene).loads[0].force(t[:end + 1])
-    resistance = breech - scene.barrel.mass * result.barrel_acceleration[:end + 1]
-    axes[1, 1].plot(1e3 * result.barrel_position[:end + 1][after_pulse], resistance[after_pulse] / 1e3,
+    stroke, resistance = recoil_stroke(result, until=result.shots[0]["time_of_max_barrel_displacement"])
+    after_pulse = t[:len(stroke)] > scene.firing.pulse.table[0][-1]  # the breech force accelerates, not resists
+    axes[1, 1].plot(1e3 * stroke[after_pulse], resistance[after_pulse] / 1e3,
                     label="total resistance F_breech - M a (after the pulse)")
     axes[1, 1].axhline(comparison.design.resistance / 1e3, color="grey", ls=":", label="design: constant R")
     axes[1, 1].set_xlabel("barrel displacement (mm), first shot")

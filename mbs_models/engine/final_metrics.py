@@ -118,12 +118,15 @@ def check_metric_names(names, key: str = "stop_when_final") -> tuple[str, ...]:
     return tuple(name for name in FINAL_METRICS if name in items)
 
 
-def dissipative(scene: Scene) -> bool:
+def dissipative(scene: Scene | Mechanism) -> bool:
     """True when the scene's mechanical energy never increases after its last external input: every
-    reading but literal_lambda_sign, and no load that acts for ever (gravity along an inclined cradle)."""
+    reading but literal_lambda_sign, and no load that acts for ever (gravity along an inclined cradle).
+    Give the scene's :class:`Mechanism` if you have one (building one solves a preload's equilibrium)."""
+    mechanism = scene if isinstance(scene, Mechanism) else None
+    scene = mechanism.scene if mechanism is not None else scene
     if scene.conventions.literal_lambda_sign:
         return False
-    return math.isfinite(Mechanism(scene).last_input_time)
+    return math.isfinite((mechanism or Mechanism(scene)).last_input_time)
 
 
 class _QuadraticForm:
@@ -561,7 +564,7 @@ class FinalityTracker:
         self.scene = self.mechanism.scene
         self.requested = check_metric_names(requested)
         self.impact_threshold = float(impact_threshold)
-        self.enabled = dissipative(self.scene)
+        self.enabled = dissipative(self.mechanism)
         #: the energy bounds hold only after the last shot or pulse (s): states before it prove nothing
         self.after = self.mechanism.last_input_time
         self.max_barrel_position = -math.inf

@@ -468,12 +468,12 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
     energy_error = (result.kinetic_energy_history + result.stored_energy_history
                     + sum(result.dissipated_energy_history.values()) - mechanism.initial_energy())
     mechanical = result.kinetic_energy_history + result.stored_energy_history
-    scale = None
+    scale = mechanism.energy_scale()  # the mechanism at hand: building another solves a preload's equilibrium again
     if result.work_histories:
         work = result.work_history
         energy_error = energy_error - work
         mechanical = mechanical - work  # what never increases once the inputs are counted
-        scale = mechanism.energy_scale() + float(np.max(np.abs(work)))
+        scale += float(np.max(np.abs(work)))
     stability.check_energy_balance(scene, samples.time, energy_error, f"Exudyn {settings.label()}", scale)
     floor = tracker.bounds.energy_floor if stopped else 0.0  # the energy's lower bound (a preload's well)
     if stopped and largest_energy_rise(mechanical - floor) > ENERGY_SLACK:

@@ -162,10 +162,11 @@ def peak_support_force_in_recoil(result) -> float:
     return float(np.max(np.abs(result.support_force[:end + 1])))
 
 
-def recoil_stroke(result) -> tuple[np.ndarray, np.ndarray]:
-    """(x m, resistance N) of the barrel from t = 0 to its maximum displacement: ``-M a`` plus the external
-    loads on the barrel that are inputs (the breech force), i.e. what the mechanism and gravity resist with."""
-    end = int(np.searchsorted(result.time, result.time_of_max_barrel_displacement))
+def recoil_stroke(result, until: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """(x m, resistance N) of the barrel from t = 0 to its maximum displacement (or to ``until`` s): ``-M a``
+    plus the external loads on the barrel that are inputs (the breech force), i.e. what the mechanism and
+    gravity resist with."""
+    end = int(np.searchsorted(result.time, result.time_of_max_barrel_displacement if until is None else until))
     mass = result.scene.barrel.mass
     t = result.time[:end + 1]
     resistance = -mass * result.barrel_acceleration[:end + 1]
