@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import base64
 import html
+import importlib
 import math
 import multiprocessing
 import os
@@ -30,8 +31,6 @@ import numpy as np
 from mbs_models import model_i, model_ii, simplified_model, simulate
 from mbs_models.scene.models import model_i as _model_i_doc, model_ii as _model_ii_doc, simplified_model as _simp_doc
 from mbs_models.outputs import atomic_write_json, atomic_write_text, prepare_output_dir
-from mbs_models.results.plotting import (MODEL_COLOURS, figure_png, new_figure, plot_barrel_displacements,
-                                 plot_contact_histories, plot_first_impact)
 from mbs_models.scene import Scene
 from mbs_models.studies.sweep import default_workers, parallel_map, process_pool, run_sweep_jobs, sweep_jobs
 
@@ -190,12 +189,19 @@ def compute_report(options: ReportOptions = ReportOptions(), progress: Progress 
     start = time.perf_counter()
     stages = {name: _Stage(name, len(items), progress) for name, _, items in plan}
     with process_pool(options.workers) as pool:
-        futures = {}
+        pending = {}
         for name, function, items in plan:
             for index, args in enumerate(items):
-                futures[pool.submit(_timed, function, *args)] = (name, index)
-        for future in as_completed(futures):
-            name, index = futures[future]
+                future = pool.submit(_timed, function, *args)
+                if future.done():  # run in this process (workers=1): report it now
+                    stages[name].finish(index, *future.result())
+                else:
+                    pending[future] = (name, index)
+        # matplotlib is needed for the figures only: import it here while the workers compute (they were
+        # forked without it)
+        importlib.import_module("mbs_models.results.plotting")
+        for future in as_completed(pending):
+            name, index = pending[future]
             stages[name].finish(index, *future.result())
     compute_wall = time.perf_counter() - start
 
@@ -259,6 +265,7 @@ def compute_report(options: ReportOptions = ReportOptions(), progress: Progress 
 
 # ------------------------------------------------------------------------------------------- figures
 def _sweep_figure(data: dict, model: str, fig_number: int):
+    from mbs_models.results.plotting import MODEL_COLOURS, new_figure
     fig, axes = new_figure(1, 1, row_height=3.8)
     ax = axes[0, 0]
     colours = {100.0: "#2ca02c", 500.0: "#ff7f0e", 1000.0: "#9467bd"}
@@ -282,6 +289,7 @@ def _sweep_figure(data: dict, model: str, fig_number: int):
 
 
 def _convention_figure(data: dict):
+    from mbs_models.results.plotting import new_figure
     fig, axes = new_figure(1, 1, row_height=3.6)
     ax = axes[0, 0]
     for row in data["conventions"]:
@@ -305,6 +313,7 @@ def mount_force_mass(data: dict) -> float:
 
 def _mount_force_figure(data: dict, mass: float):
     """The force on the mount (support force, kN) vs time of the three models at one absorber mass, gap 0."""
+    from mbs_models.results.plotting import MODEL_COLOURS, new_figure
     fig, axes = new_figure(1, 1, row_height=3.6)
     ax = axes[0, 0]
     runs = data["runs"]
@@ -333,11 +342,13 @@ _PENDING_FIGURES: list[tuple[str, Callable]] = []
 
 def _render_pending(index: int) -> bytes:
     """PNG bytes of the ``index``-th pending figure (runs in a forked worker)."""
+    from mbs_models.results.plotting import figure_png
     return figure_png(_PENDING_FIGURES[index][1]())
 
 
 def figure_builders(data: dict) -> list[tuple[str, Callable]]:
     """Every figure of the report as (file stem, zero-argument builder returning a Figure)."""
+    from mbs_models.results.plotting import plot_barrel_displacements, plot_contact_histories, plot_first_impact
     runs = data["runs"]
     builders = [("fig4_gap_sweep_model_i", partial(_sweep_figure, data, MODEL_I, 4)),
                 ("fig5_gap_sweep_model_ii", partial(_sweep_figure, data, MODEL_II, 5))]
@@ -368,6 +379,7 @@ def make_figures(data: dict, workers: int | None = None) -> dict[str, bytes]:
     pickled; elsewhere, or with ``workers=1``, the figures are rendered here one by one.
     """
     global _PENDING_FIGURES
+    from mbs_models.results.plotting import figure_png
     builders = figure_builders(data)
     if workers == 1 or "fork" not in multiprocessing.get_all_start_methods():
         return {name: figure_png(build()) for name, build in builders}
