@@ -107,8 +107,9 @@ class DaskBackend(SerialBackend):
             try:
                 self.client = distributed.Client(scheduler.strip(), timeout=timeout, set_as_default=False)
             except (OSError, TimeoutError, ValueError) as exc:
+                reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
                 raise SceneError("scheduler", f"cannot connect to the Dask scheduler at {scheduler!r}: "
-                                              f"{str(exc).splitlines()[0] if str(exc) else type(exc).__name__}") from None
+                                              f"{reason}") from None
             self._own = True
         else:
             raise SceneError("scheduler", f"must be an address tcp://HOST:PORT or a dask.distributed.Client, "

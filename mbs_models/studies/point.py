@@ -71,7 +71,8 @@ def _stops(scene: Scene) -> list[str]:
     from ..elements.absorber import Absorber
     from ..elements.contact_laws import LawFields
 
-    return [name for name, table in scene.elements() if isinstance(table, LawFields) and not isinstance(table, Absorber)]
+    return [name for name, table in scene.elements()
+            if isinstance(table, LawFields) and not isinstance(table, Absorber)]
 
 
 def metric_columns(scene: Scene) -> list[str]:
@@ -124,7 +125,8 @@ def evaluate_point(scene: Scene, overrides: Mapping[str, Any], settings: PointSe
     return row
 
 
-def evaluate_batch(task: tuple[Scene, PointSettings, Sequence[tuple[int, Mapping[str, Any]]]]) -> list[tuple[int, dict]]:
+def evaluate_batch(task: tuple[Scene, PointSettings, Sequence[tuple[int, Mapping[str, Any]]]]
+                   ) -> list[tuple[int, dict]]:
     """``[(index, evaluate_point(scene, overrides, settings)) for index, overrides in points]``: the unit of
     work a backend sends to a worker (several points per task amortise its overhead)."""
     scene, settings, points = task
