@@ -28,6 +28,8 @@ from ..errors import SceneError
 from .point import COUNT_COLUMNS, STATUS_COLUMNS, TEXT_COLUMNS
 
 FORMATS = {".csv": "csv", ".parquet": "parquet"}
+#: read_csv's arguments for floats that round-trip exactly (pandas 3 does by default and deprecates the option).
+_EXACT_FLOATS = {"float_precision": "round_trip"} if int(pd.__version__.split(".")[0]) < 3 else {}
 
 
 def _is_count(column: str) -> bool:
@@ -131,8 +133,8 @@ class SweepFile:
                 handle.write(text)
         if not text.strip():
             return pd.DataFrame(columns=self.columns)
-        return pd.read_csv(io.StringIO(text), float_precision="round_trip", keep_default_na=False,
-                           na_values=[""], dtype={c: object for c in TEXT_COLUMNS})
+        return pd.read_csv(io.StringIO(text), keep_default_na=False, na_values=[""],
+                           dtype={c: object for c in TEXT_COLUMNS}, **_EXACT_FLOATS)
 
     # ------------------------------------------------------------------ writing
     def append(self, rows: Sequence[dict]) -> None:
