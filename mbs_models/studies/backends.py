@@ -105,7 +105,7 @@ class DaskBackend(SerialBackend):
             self.client, self._own = scheduler, False
         elif isinstance(scheduler, str) and scheduler.strip():
             try:
-                self.client = distributed.Client(scheduler.strip(), timeout=timeout, set_as_default=False)
+                self.client = distributed.Client(scheduler.strip(), timeout=timeout)
             except (OSError, TimeoutError, ValueError) as exc:
                 reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
                 raise SceneError("scheduler", f"cannot connect to the Dask scheduler at {scheduler!r}: "
