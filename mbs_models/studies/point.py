@@ -33,7 +33,7 @@ SCALAR_METRICS = (
 )
 #: Per absorber (scenes with several), as ``absorber.N.<metric>``.
 ABSORBER_METRICS = ("peak_contact_force", "max_absorber_velocity", "impacts")
-#: Per end stop (``recoil_stop``, ``battery_stop``), as ``<stop>.<metric>``.
+#: Per end stop (a contact with the ground that is no absorber), as ``<element name>.<metric>``.
 STOP_METRICS = ("peak_contact_force", "impacts", "dissipated_energy")
 #: Run information after the metrics: the barrel's initial velocity (m/s), the simulated end time (s, less
 #: than asked with an early stop), why the run ended, the solver's steps.

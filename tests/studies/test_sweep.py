@@ -1,11 +1,19 @@
-"""Parallel sweeps (mbs_models.studies.sweep): same numbers as serial runs, failures kept per point."""
+"""Sweeps (mbs_models.studies.sweep): run_sweep's grids (the numbers of single runs whichever backend runs them,
+resuming, failures kept per point) and the scene lists of run_scenes/gap_sweep/parallel_map."""
 
 from __future__ import annotations
 
+import os
+import signal
+
+import pandas as pd
 import pytest
 
+import mbs_models
 from mbs_models import Conventions, SceneError, model_i, model_ii, simulate
-from mbs_models.studies.sweep import gap_sweep, parallel_map, run_scenes
+from mbs_models.studies import point as point_module
+from mbs_models.studies.point import SCALAR_METRICS
+from mbs_models.studies.sweep import gap_sweep, parallel_map, run_scenes, run_sweep
 
 
 def test_parallel_gap_sweep_equals_serial_simulate():
@@ -46,16 +54,6 @@ def test_progress_is_reported():
 
 
 # ================================================================================================ run_sweep: grids
-import os  # noqa: E402
-import signal  # noqa: E402
-
-import pandas as pd  # noqa: E402
-
-import mbs_models  # noqa: E402
-from mbs_models.studies import point as point_module  # noqa: E402
-from mbs_models.studies.point import SCALAR_METRICS  # noqa: E402
-from mbs_models.studies.sweep import run_sweep  # noqa: E402
-
 FIG_GRID = {"absorber.mass": [100.0, 1000.0], "contact.gap": [0.0, 0.04, 0.08]}  # Figs 4/5, reduced
 
 
@@ -228,3 +226,15 @@ def test_a_dask_worker_killed_mid_sweep_loses_no_point(dask_cluster, tmp_path):
     assert table.attrs["sweep"]["run"] == 12 and (table["status"] == "ok").all()
     pd.testing.assert_frame_equal(_values(table), _values(serial))
     _assert_file_holds(tmp_path / "k.csv", serial)
+
+
+def test_a_tqdm_bar_on_a_terminal_only(capsys, monkeypatch):
+    grid = {"contact.gap": [0.0, 0.01]}
+    run_sweep(model_i(), grid, end_time=0.2, workers=1, batch_size=1)
+    assert capsys.readouterr().err == ""                      # not a terminal: no bar
+    monkeypatch.setattr("sys.stderr.isatty", lambda: True)
+    run_sweep(model_i(), grid, end_time=0.2, workers=1, batch_size=1)
+    err = capsys.readouterr().err
+    assert "sweep: 100%" in err and "2/2" in err and "point/s" in err   # the rate (and the time left) shown
+    run_sweep(model_i(), grid, end_time=0.2, workers=1, progress=False)
+    assert capsys.readouterr().err == ""
