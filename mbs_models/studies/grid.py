@@ -39,18 +39,22 @@ class Grid:
         return [dict(zip(self.keys, combination)) for combination in itertools.product(*self.values)]
 
     def labels(self) -> list[tuple]:
-        """Every point's parameter values as they stand in the table (:func:`column_value`), in point order."""
-        return [tuple(column_value(v) for v in combination) for combination in itertools.product(*self.values)]
+        """Every point's parameter values as they stand in the table (:func:`column_values`), in point order."""
+        return list(itertools.product(*(column_values(values) for values in self.values)))
 
 
-def column_value(value: Any) -> Any:
-    """A parameter value as a table cell: numbers as float, booleans and strings as they are, lists (a
-    table of pairs) as their TOML text."""
-    if isinstance(value, bool) or isinstance(value, str):
-        return value
-    if isinstance(value, numbers.Real):
-        return float(value)
-    return _toml_value(value)
+def _is_number(value: Any) -> bool:
+    return isinstance(value, numbers.Real) and not isinstance(value, bool)
+
+
+def column_values(values: Sequence[Any]) -> list[Any]:
+    """One parameter's values as table cells, of one type per column: numbers as float, booleans as they are;
+    otherwise text (strings as they are, any other value -- a table of pairs -- as its TOML text)."""
+    if all(_is_number(v) for v in values):
+        return [float(v) for v in values]
+    if all(isinstance(v, bool) for v in values):
+        return list(values)
+    return [v if isinstance(v, str) else _toml_value(v) for v in values]
 
 
 def _normalise(value: Any, key: str) -> Any:
@@ -81,7 +85,7 @@ def make_grid(scene: Scene, params: Mapping[str, Sequence[Any] | str]) -> Grid:
         items = [_normalise(v, key) for v in items]
         if not items:
             raise SceneError(key, "no values given")
-        labels = [column_value(v) for v in items]
+        labels = column_values(items)
         for i, label in enumerate(labels):
             if label in labels[:i]:
                 raise SceneError(key, f"value {label!r} given twice")
@@ -118,4 +122,4 @@ def _accepts(scene: Scene, overrides: dict) -> bool:
     return True
 
 
-__all__ = ["Grid", "make_grid", "check_values", "column_value"]
+__all__ = ["Grid", "make_grid", "check_values", "column_values"]

@@ -213,9 +213,11 @@ def run_sweep(scene: Scene, params, *, end_time: float = 10.0, accuracy: str | S
         bar = _progress_bar(progress, len(points), len(done))
         try:
             for batch in backend.run(evaluate_batch, tasks):
-                rows = [row for _, row in batch]
+                rows = []
                 for index, row in batch:
+                    row.update(zip(params_columns, labels[index]))  # the values as table cells (lists as TOML)
                     new[index] = row
+                    rows.append(row)
                 if file is not None:
                     file.append(rows)
                 bar(len(batch))

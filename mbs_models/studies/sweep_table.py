@@ -2,7 +2,7 @@
 
 One row per point: the parameters (one column per dotted key), the metrics
 (:func:`~mbs_models.studies.point.metric_columns`), ``wall_time``, ``status``, ``error``.  Types are
-fixed by the column (:func:`frame`): parameters as :func:`~mbs_models.studies.grid.column_value` gives
+fixed by the column (:func:`frame`): parameters as :func:`~mbs_models.studies.grid.column_values` gives
 them, metrics ``float64``, counts nullable ``Int64``, text ``object`` (None where empty), so that a table
 read back from its file equals the one built in memory.
 

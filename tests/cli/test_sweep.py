@@ -99,3 +99,24 @@ def test_bad_set_exits_2(capsys, command, assignment, needle):
     assert main([command, "model_i", "--set", assignment]) == 2
     err = capsys.readouterr().err
     assert needle in err and len(err.strip().splitlines()) == 1
+
+
+def test_a_table_valued_parameter_is_swept_and_resumed(tmp_path, capsys):
+    """``recoil_brake.orifice_area`` as a number or a table of (stroke, area) pairs: a TOML array spec; the
+    column holds each value's TOML text, so the file resumes."""
+    from mbs_models import load_scene
+    from mbs_models.scene.overrides import apply_overrides
+    from mbs_models.scenes import scene_path
+
+    out = tmp_path / "brake.csv"
+    argv = ["sweep", "recoil_brake", "--param", "recoil_brake.orifice_area=[3e-4, [[0.0, 4e-4], [0.2, 2e-4]]]",
+            "--out", str(out), "--end-time", "0.5", "--workers", "1"]
+    assert main(argv) == 0
+    table = pd.read_csv(out)
+    assert table["recoil_brake.orifice_area"].tolist() == ["0.0003", "[[0.0, 0.0004], [0.2, 0.0002]]"]
+    scene = load_scene(scene_path("recoil_brake"))
+    for value, row in zip([3e-4, [[0.0, 4e-4], [0.2, 2e-4]]], table.to_dict("records")):
+        expected = simulate(apply_overrides(scene, {"recoil_brake.orifice_area": value}), 0.5)
+        assert row["max_barrel_displacement"] == expected.max_barrel_displacement
+    assert main(argv) == 0
+    assert "2 points: 0 run, 2 resumed" in capsys.readouterr().out

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from mbs_models import SceneError, model_i
-from mbs_models.studies.grid import column_value, make_grid
+from mbs_models.studies.grid import column_values, make_grid
 
 
 def test_full_grid_first_key_slowest():
@@ -22,11 +22,11 @@ def test_ranges_and_numpy_values():
     assert all(type(v) is float for v in grid.values[1])
 
 
-def test_column_values():
-    assert column_value(500) == 500.0 and type(column_value(500)) is float
-    assert column_value(True) is True
-    assert column_value("flores") == "flores"
-    assert column_value([[0.0, 3e-4], [0.3, 1e-4]]) == "[[0.0, 0.0003], [0.3, 0.0001]]"
+def test_column_values_have_one_type_per_column():
+    assert column_values([500, 0.5]) == [500.0, 0.5] and type(column_values([500])[0]) is float
+    assert column_values([True, False]) == [True, False]
+    assert column_values(["flores", "hertz"]) == ["flores", "hertz"]
+    assert column_values([2e-4, [[0.0, 3e-4], [0.3, 1e-4]]]) == ["0.0002", "[[0.0, 0.0003], [0.3, 0.0001]]"]
 
 
 @pytest.mark.parametrize("params, key, needle", [
