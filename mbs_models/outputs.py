@@ -45,6 +45,23 @@ def current_umask() -> int:
     return mask
 
 
+def check_output_file(path: str | Path, key: str) -> Path:
+    """Check that a file can be written at ``path``: its directory exists and is writable, and ``path``
+    is not a directory.  SceneError naming ``key`` otherwise; nothing is created (a missing directory is
+    refused, not made: a typo must not leave a directory tree behind)."""
+    path = Path(path)
+    directory = path.parent
+    if path.is_dir():
+        raise SceneError(key, f"{path} is a directory, not a file")
+    if not directory.exists():
+        raise SceneError(key, f"directory {directory} does not exist")
+    if not directory.is_dir():
+        raise SceneError(key, f"{directory} is not a directory")
+    if not os.access(directory, os.W_OK | os.X_OK):
+        raise SceneError(key, f"directory {directory} is not writable")
+    return path
+
+
 def atomic_write_bytes(path: str | Path, data: bytes) -> Path:
     """Write ``data`` to ``path`` via a temporary file in the same directory and an atomic rename.
 
