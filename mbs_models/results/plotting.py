@@ -144,7 +144,7 @@ def _plot_impact_zoom(ax, result: Result, impact, padding: float) -> None:
     ax.plot(result.time[mask] * 1e3, result.support_force[mask] / 1e3, "-", color="#444444", lw=1.0,
             label="force on the mount")
     ax.axhline(0.0, color="#999999", lw=0.6)
-    ax.set_title(f"first impact (at {impact.start:.4f} s)", fontsize=9)
+    ax.set_title(f"first impact (from {impact.start:.4g} s)", fontsize=9)
     ax.set_xlabel("time [ms]")
     ax.set_ylabel("force [kN]")
     ax.legend(fontsize=8, loc="upper right")
