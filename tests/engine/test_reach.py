@@ -6,6 +6,8 @@ from __future__ import annotations
 import math
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from mbs_models import load_scene, model_i, model_ii, simplified_model, simulate
 from mbs_models.engine.final_metrics import ENERGY_SLACK
@@ -71,3 +73,32 @@ def test_one_of_several_contacts_out_of_reach():
     [found] = contacts_out_of_reach(scene)
     assert found.key == "absorber.1.contact.gap" and found.length == 40.0
     assert 0.0 < found.reach < 40.0 and rear.contact.gap == 0.02
+
+
+def test_the_bound_is_tight_for_an_undamped_barrel():
+    """Without the recoil damper the barrel's free recoil reaches sqrt(2 E0 / k) exactly: a gap 0.1 % short
+    of it closes (and is not reported), one beyond the bound (which adds only ENERGY_SLACK) stays open."""
+    undamped = model_ii(1000.0, 0.0).with_changes(recoil_damper=None)
+    travel = math.sqrt(2.0 * 0.5 * undamped.barrel.mass * undamped.initial_velocity ** 2
+                       / undamped.recoil_spring.stiffness)
+    short = undamped.with_changes(**{"contact.gap": 0.999 * travel})
+    assert contacts_out_of_reach(short) == []
+    assert simulate(short, 1.5, "draft").peak_contact_force > 0.0
+    beyond = undamped.with_changes(**{"contact.gap": travel * (1.0 + ENERGY_SLACK)})
+    [found] = contacts_out_of_reach(beyond)
+    assert found.reach <= beyond.absorber.contact.gap
+    assert simulate(beyond, 1.5, "standard").peak_contact_force == 0.0
+
+
+@settings(max_examples=12, deadline=None)
+@given(mass=st.floats(100.0, 3000.0), fraction=st.floats(0.3, 2.0), mount=st.sampled_from([model_i, model_ii]),
+       damping=st.floats(0.0, 1.0))
+def test_a_reported_contact_never_closes(mass, fraction, mount, damping):
+    """Random absorbers and gaps around the barrel's undamped free travel, recoil damping scaled down to 0:
+    whatever is reported stays open in the solve, whatever closes is not reported."""
+    base = mount(mass, 0.0)
+    scene = base.with_changes(**{"recoil_damper.recoil": damping * base.recoil_damper.recoil,
+                                 "contact.gap": fraction * _undamped_free_travel(base)})
+    reported = contacts_out_of_reach(scene)
+    peak = simulate(scene, 2.0, "draft").peak_contact_force
+    assert not (reported and peak > 0.0), (reported, peak)
