@@ -180,7 +180,8 @@ def build_parser() -> argparse.ArgumentParser:
     validate.add_argument("--end-time", type=float, default=10.0, help="simulated time in s (default 10)")
     validate.add_argument("--accuracy", default="standard", choices=("draft", "standard", "reference"),
                           help=ACCURACY_HELP)
-    validate.add_argument("--impact-threshold", type=float, default=1000.0, help="impact threshold in N")
+    validate.add_argument("--impact-threshold", type=float, default=1000.0,
+                          help="peak force (N) above which a contact episode counts as an impact (default 1000)")
     validate.add_argument("--json", action="store_true", help="print the comparison as JSON")
     validate.set_defaults(handler=_cmd_validate)
 
@@ -239,8 +240,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except SimulationError as exc:
         print(f"recoil: simulation failed: {exc}", file=sys.stderr)
         return EXIT_FAILED
-    except BrokenPipeError:  # the output was piped into a program that stopped reading (head): not an error
-        sys.stdout = open(os.devnull, "w")  # noqa: SIM115 -- keeps the interpreter's final flush quiet
+    except BrokenPipeError:  # piped into a program that stopped reading (head): the run itself succeeded
+        try:  # Python's documented recipe: the interpreter's final flush goes to /dev/null, not a traceback
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        except (OSError, ValueError, AttributeError):
+            pass
         return EXIT_OK
     except KeyboardInterrupt:
         print("recoil: interrupted", file=sys.stderr)

@@ -180,3 +180,12 @@ def test_validate_warns_of_a_contact_that_cannot_close(tmp_path, capsys):
     main(["validate", str(path), "--end-time", "0.5", "--accuracy", "draft"])
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("recoil: warning: absorber.contact.gap = 40 m")
+
+
+def test_output_piped_into_a_reader_that_stops_gives_no_traceback():
+    """``recoil run ... | head -1``: the reader closes the pipe; no traceback, the run's exit code."""
+    proc = subprocess.Popen([sys.executable, "-m", "mbs_models", "run", "model_ii", "--end-time", "0.2",
+                             "--accuracy", "draft"], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc.stdout.close()  # before the process writes anything (it is still importing)
+    err = proc.stderr.read().decode()
+    assert proc.wait() == 0 and "Traceback" not in err and "BrokenPipe" not in err, err
