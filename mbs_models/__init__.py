@@ -37,6 +37,7 @@ _LAZY = {
     "Mechanism": ".engine.mechanism",
     "FINAL_METRICS": ".engine.final_metrics",   # names accepted by simulate(..., stop_when_final=...)
     "EnergyBounds": ".engine.final_metrics",
+    "contacts_out_of_reach": ".engine.reach",  # gaps and stops beyond the barrel's free-recoil travel
     "add_contact": ".elements.contact_laws",
     "add_recoil_damper": ".elements.recoil_damper",
     "add_recoil_brake": ".elements.recoil_brake",

@@ -85,3 +85,18 @@ def test_the_files_that_know_about_an_effect_are_the_ones_listed():
     knowing = {path for path in tracked if path.endswith((".py", ".toml")) and path != "tests/test_readme.py"
                and names.search((root / path).read_text(errors="replace"))}  # (this checker names them, of course)
     assert knowing == listed
+
+
+def test_the_early_stop_example_prints_what_its_comment_says(capsys):
+    """The "From Python" block's early stop: the commented end time (s), stop reason and maximum (m)."""
+    block = _python_block_after("### From Python")
+    lines = block.splitlines()
+    i = next(n for n, line in enumerate(lines) if "stop_when_final=" in line and line.startswith("result ="))
+    call, printed = lines[i], lines[i + 1]
+    match = re.search(r"# ~(\S+) s, (\w+), (\S+) m$", printed)
+    assert match, printed
+    exec(compile(f"from mbs_models import model_ii, simulate\n{call}\n{printed}", "README", "exec"), {})
+    end_time, reason, x_max = capsys.readouterr().out.split()
+    assert float(end_time) == pytest.approx(float(match.group(1)), abs=0.006)
+    assert reason == match.group(2)
+    assert f"{float(x_max):.4f}" == match.group(3)
