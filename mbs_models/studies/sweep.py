@@ -165,7 +165,8 @@ def run_sweep(scene: Scene, params, *, end_time: float = 10.0, accuracy: str | S
     ``out``: a ``.csv`` (or, with pyarrow, ``.parquet``) file; rows are written as they finish and, at
     the end, the file holds the table in grid order.  If ``out`` already holds rows of the same sweep, only
     the points not yet in it run (a killed sweep resumes; the resumed table equals an uninterrupted one
-    but for ``wall_time``).  ``progress``: a tqdm bar on a terminal (rate, ETA), False for none, or a
+    but for ``wall_time``); ``FILE.sweep.json`` beside it records the scene and settings, and a file
+    computed with others is refused.  ``progress``: a tqdm bar on a terminal (rate, ETA), False for none, or a
     callable ``progress(done, total)``.  ``end_time``, ``accuracy``, ``stop_when_final`` and
     ``impact_threshold`` are those of :func:`~mbs_models.simulate`; ``batch_size``: points per task
     (default: about four tasks per worker, at most 16 points each).
@@ -198,9 +199,14 @@ def run_sweep(scene: Scene, params, *, end_time: float = 10.0, accuracy: str | S
     labels = grid.labels()
     points = grid.points()
     file = SweepFile(out, params_columns, metrics) if out is not None else None
+    if file is not None:
+        recorded = _settings_record(scene, settings)
+        file.check_settings(recorded)
     done = _rows_in_file(file, labels) if file is not None else {}
     pending = [(i, point) for i, (point, label) in enumerate(zip(points, labels)) if label not in done]
     backend = _backends.make_backend(workers, scheduler) if pending else _backends.SerialBackend()
+    if file is not None:
+        file.write_settings(recorded)
     with backend:
         size = batch_size or _backends.batch_size(len(pending), backend.workers)
         tasks = [(scene, settings, pending[i:i + size]) for i in range(0, len(pending), size)]
@@ -228,6 +234,15 @@ def run_sweep(scene: Scene, params, *, end_time: float = 10.0, accuracy: str | S
                             "failed": int((table["status"] != "ok").sum()),
                             "out": None if file is None else str(file.path)}
     return table
+
+
+def _settings_record(scene: Scene, settings) -> dict:
+    """What every row of a sweep's file is computed with: the scene (its TOML text) and the point settings."""
+    from ..scene.io import scene_to_toml
+
+    accuracy = settings.accuracy if isinstance(settings.accuracy, str) else repr(settings.accuracy)
+    return {"scene": scene_to_toml(scene), "end_time": settings.end_time, "accuracy": accuracy,
+            "stop_when_final": list(settings.stop_when_final), "impact_threshold": settings.impact_threshold}
 
 
 def _rows_in_file(file, labels: list[tuple]) -> dict[tuple, dict]:

@@ -10,12 +10,15 @@ read back from its file equals the one built in memory.
 whole file rewritten atomically, at most every ``parquet_interval`` seconds, since Parquet cannot be
 appended to) and, at the end, rewrites the file in grid order.  :meth:`SweepFile.read` reads what a
 previous run of the same sweep left (a CSV line cut short by a kill is dropped), so that a sweep resumes
-with the points not yet in the file.
+with the points not yet in the file; ``FILE.sweep.json`` beside it records what the rows were computed
+with (the scene, end time, accuracy...), and a run with other settings is refused
+(:meth:`SweepFile.check_settings`) rather than mixed in.
 """
 
 from __future__ import annotations
 
 import io
+import json
 import os
 import tempfile
 import time
@@ -104,6 +107,33 @@ class SweepFile:
         self._rows: list[dict] = []     # Parquet: every row so far (the file is rewritten whole)
         self._last_write = 0.0
 
+    # ------------------------------------------------------------------ what the rows were computed with
+    @property
+    def settings_path(self) -> Path:
+        """The file beside the table that records what its rows were computed with (``FILE.sweep.json``)."""
+        return self.path.with_name(self.path.name + ".sweep.json")
+
+    def check_settings(self, settings: dict[str, Any]) -> None:
+        """SceneError if the table's rows were computed with other ``settings`` (the scene, end time,
+        accuracy...) than these; nothing is known of a table without its settings file (it is taken as is)."""
+        if not self.path.exists() or not self.settings_path.exists():
+            return
+        try:
+            recorded = json.loads(self.settings_path.read_text(encoding="utf-8"))
+        except (OSError, ValueError) as exc:
+            raise SceneError("out", f"cannot read {self.settings_path} (what {self.path} was computed with): "
+                                    f"{exc}; delete both to start again") from None
+        differing = [key for key in sorted(set(recorded) | set(settings)) if recorded.get(key) != settings.get(key)]
+        if differing:
+            raise SceneError("out", f"{self.path} holds a sweep computed with another {', '.join(differing)} "
+                                    f"(see {self.settings_path.name}): choose another file, or delete both to "
+                                    "start again")
+
+    def write_settings(self, settings: dict[str, Any]) -> None:
+        """Record what the rows are computed with (atomically)."""
+        text = json.dumps(settings, indent=2, sort_keys=True) + "\n"
+        self._atomic(lambda path: Path(path).write_text(text, encoding="utf-8"), self.settings_path)
+
     # ------------------------------------------------------------------ reading
     def read(self) -> pd.DataFrame:
         """The rows a previous run left in the file (an empty table if there is none); SceneError if the
@@ -169,12 +199,13 @@ class SweepFile:
         self._atomic(lambda path: table.to_parquet(path, index=False))
         self._last_write = time.monotonic()
 
-    def _atomic(self, write) -> None:
-        handle, temporary = tempfile.mkstemp(prefix=f".{self.path.name}.", dir=self.path.parent or ".")
+    def _atomic(self, write, target: Path | None = None) -> None:
+        target = self.path if target is None else target
+        handle, temporary = tempfile.mkstemp(prefix=f".{target.name}.", dir=target.parent or ".")
         os.close(handle)
         try:
             write(temporary)
-            os.replace(temporary, self.path)
+            os.replace(temporary, target)
         except BaseException:
             Path(temporary).unlink(missing_ok=True)
             raise

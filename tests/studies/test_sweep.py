@@ -246,3 +246,21 @@ def test_bad_workers_are_refused_even_with_nothing_left_to_run(tmp_path):
     with pytest.raises(SceneError) as info:
         run_sweep(model_i(), {"contact.gap": [0.0]}, end_time=0.2, workers=0, progress=False, out=path)
     assert info.value.key == "workers"
+
+
+@pytest.mark.parametrize("change", [{"end_time": 0.3}, {"accuracy": "draft"}, {"scene": model_i(500.0, 0.0)},
+                                    {"stop_when_final": ("max_barrel_displacement",)}],
+                         ids=["end_time", "accuracy", "scene", "stop_when_final"])
+def test_a_file_computed_with_other_settings_is_not_resumed(tmp_path, change):
+    path = tmp_path / "s.csv"
+    arguments = {"scene": model_i(), "end_time": 0.2, "accuracy": "standard"}
+    run_sweep(params={"contact.gap": [0.0]}, workers=1, progress=False, out=path, **arguments)
+    assert (tmp_path / "s.csv.sweep.json").exists()
+    before = path.read_text()
+    with pytest.raises(SceneError) as info:
+        run_sweep(params={"contact.gap": [0.0, 0.01]}, workers=1, progress=False, out=path,
+                  **{**arguments, **change})
+    assert info.value.key == "out" and f"another {next(iter(change))}" in info.value.message
+    assert path.read_text() == before
+    table = run_sweep(params={"contact.gap": [0.0, 0.01]}, workers=1, progress=False, out=path, **arguments)
+    assert table.attrs["sweep"]["resumed"] == 1
