@@ -120,3 +120,13 @@ def test_a_table_valued_parameter_is_swept_and_resumed(tmp_path, capsys):
         assert row["max_barrel_displacement"] == expected.max_barrel_displacement
     assert main(argv) == 0
     assert "2 points: 0 run, 2 resumed" in capsys.readouterr().out
+
+
+def test_another_end_time_into_the_same_file_exits_2(tmp_path, capsys):
+    out = tmp_path / "s.csv"
+    argv = ["sweep", "model_i", "--param", "contact.gap=0", "--out", str(out), "--workers", "1"]
+    assert main([*argv, "--end-time", "0.2"]) == 0
+    capsys.readouterr()
+    assert main([*argv, "--end-time", "0.3"]) == 2
+    err = capsys.readouterr().err
+    assert "--out:" in err and "another end_time" in err and len(err.strip().splitlines()) == 1
