@@ -25,6 +25,7 @@ import time
 from pathlib import Path
 from typing import Any, Iterable, Sequence
 
+import numpy as np
 import pandas as pd
 
 from ..errors import SceneError
@@ -45,24 +46,25 @@ def _is_text(column: str) -> bool:
 
 def frame(rows: Iterable[dict], params: Sequence[str], metrics: Sequence[str]) -> pd.DataFrame:
     """The typed table of ``rows`` with the columns ``params + metrics + STATUS_COLUMNS``."""
+    rows = list(rows)
     columns = [*params, *metrics, *STATUS_COLUMNS]
-    table = pd.DataFrame(list(rows), columns=columns)
+    data = {}
     for column in columns:
-        series = table[column]
+        values = [row.get(column) for row in rows]
         if column in params:
-            if len(series) and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in series):
-                table[column] = series.astype("float64")
-            elif len(series) and all(isinstance(v, bool) for v in series):
-                table[column] = series.astype(bool)
+            if values and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values):
+                data[column] = np.array(values, dtype="float64")
+            elif values and all(isinstance(v, (bool, np.bool_)) for v in values):
+                data[column] = np.array(values, dtype=bool)
             else:
-                table[column] = series.astype(object)
+                data[column] = pd.Series(values, dtype=object)
         elif _is_text(column):
-            table[column] = pd.Series([None if _missing(v) else str(v) for v in series], dtype=object)
+            data[column] = pd.Series([None if _missing(v) else str(v) for v in values], dtype=object)
         elif _is_count(column):
-            table[column] = pd.Series([pd.NA if _missing(v) else int(v) for v in series], dtype="Int64")
+            data[column] = pd.array([pd.NA if _missing(v) else int(v) for v in values], dtype="Int64")
         else:
-            table[column] = pd.Series([float("nan") if _missing(v) else float(v) for v in series], dtype="float64")
-    return table.reset_index(drop=True)
+            data[column] = np.array([np.nan if _missing(v) else float(v) for v in values], dtype="float64")
+    return pd.DataFrame(data, columns=columns)
 
 
 def _missing(value: Any) -> bool:
