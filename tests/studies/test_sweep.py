@@ -206,23 +206,45 @@ def test_dask_equals_serial(dask_cluster):
     pd.testing.assert_frame_equal(_values(serial), _values(on_cluster))
 
 
+def _gone(pid: int, within: float = 10.0) -> bool:
+    """The process has ended (a zombie not yet reaped counts as ended)."""
+    import time
+
+    deadline = time.monotonic() + within
+    while time.monotonic() < deadline:
+        try:
+            with open(f"/proc/{pid}/stat") as handle:
+                if handle.read().split(")")[-1].split()[0] == "Z":
+                    return True
+        except OSError:
+            return True
+        time.sleep(0.1)
+    return False
+
+
 def test_a_dask_worker_killed_mid_sweep_loses_no_point(dask_cluster, tmp_path):
     from dask.distributed import Client
 
     grid = {"absorber.mass": [100.0, 1000.0], "contact.gap": [0.0, 0.02, 0.04, 0.06, 0.08, 0.1]}
     serial = run_sweep(model_ii(), grid, end_time=1.0, workers=1, progress=False)
     with Client(dask_cluster) as client:
-        pids = list(client.run(os.getpid).values())
+        pids = client.run(os.getpid)   # worker address -> pid
         killed = []
 
-        def kill_one_worker(done, total):
-            if not killed:  # after the first point: the other tasks are queued on both workers
-                os.kill(pids[0], signal.SIGKILL)
-                killed.append(pids[0])
+        def kill_a_busy_worker(done, total):
+            if killed:
+                return
+            # after a point: kill a worker that holds tasks of the sweep (or try again after the next point)
+            busy = [(address, keys) for address, keys in client.processing().items() if keys and address in pids]
+            if busy:
+                address, keys = busy[0]
+                os.kill(pids[address], signal.SIGKILL)
+                killed.append((pids[address], keys))
 
-        table = run_sweep(model_ii(), grid, end_time=1.0, scheduler=client, batch_size=1, progress=kill_one_worker,
-                          out=tmp_path / "k.csv")
-        assert killed and pids[0] not in client.run(os.getpid).values()   # the nanny started a new worker
+        table = run_sweep(model_ii(), grid, end_time=1.0, scheduler=client, batch_size=1,
+                          progress=kill_a_busy_worker, out=tmp_path / "k.csv")
+    (pid, lost), = killed
+    assert lost and _gone(pid)   # it held tasks when it died; the scheduler ran them elsewhere
     assert table.attrs["sweep"]["run"] == 12 and (table["status"] == "ok").all()
     pd.testing.assert_frame_equal(_values(table), _values(serial))
     _assert_file_holds(tmp_path / "k.csv", serial)
