@@ -120,7 +120,7 @@ class DaskBackend(SerialBackend):
             self.client, self._own = scheduler, False
         elif isinstance(scheduler, str) and scheduler.strip():
             try:
-                self.client = distributed.Client(scheduler.strip(), timeout=timeout)
+                self.client = distributed.Client(scheduler.strip(), timeout=timeout, set_as_default=False)
             except (OSError, TimeoutError, ValueError) as exc:
                 reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
                 raise SceneError("scheduler", f"cannot connect to the Dask scheduler at {scheduler!r}: "
@@ -138,7 +138,7 @@ class DaskBackend(SerialBackend):
             return
         futures = self.client.map(function, tasks, pure=False)
         try:
-            for future in distributed.as_completed(futures):
+            for future in distributed.as_completed(futures, loop=self.client.loop):
                 yield future.result()
         finally:
             self.client.cancel([f for f in futures if not f.done()])

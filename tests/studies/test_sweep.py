@@ -227,7 +227,7 @@ def test_a_dask_worker_killed_mid_sweep_loses_no_point(dask_cluster, tmp_path):
 
     grid = {"absorber.mass": [100.0, 1000.0], "contact.gap": [0.0, 0.02, 0.04, 0.06, 0.08, 0.1]}
     serial = run_sweep(model_ii(), grid, end_time=1.0, workers=1, progress=False)
-    with Client(dask_cluster) as client:
+    with Client(dask_cluster, set_as_default=False) as client:   # not the default client: named everywhere
         pids = client.run(os.getpid)   # worker address -> pid
         killed = []
 
