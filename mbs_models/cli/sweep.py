@@ -29,15 +29,19 @@ def add_set_argument(parser) -> None:
 
 
 def apply_sets(scene, assignments):
-    """``scene`` with every ``KEY=VALUE`` of ``assignments`` applied (values read as TOML)."""
+    """``scene`` with every ``KEY=VALUE`` of ``assignments`` applied (values read as TOML); its name says what
+    was changed (``model (i), m = 1000 kg, gap 0 mm, with absorber.mass=500``) unless ``name`` is set."""
     from ..scene.overrides import apply_overrides, parse_assignment, parse_value
 
-    overrides = {}
+    overrides, texts = {}, []
     for text in assignments or ():
         key, value = parse_assignment(text, "--set")
         if key in overrides:
             raise SceneError(key, "given twice with --set")
         overrides[key] = parse_value(value, key)
+        texts.append(f"{key}={value}")
+    if overrides and "name" not in overrides:
+        overrides["name"] = f"{scene.name}, with {', '.join(texts)}"
     return apply_overrides(scene, overrides)
 
 

@@ -84,11 +84,15 @@ def test_an_unreachable_scheduler_exits_2(tmp_path, capsys):
     assert "--scheduler: cannot connect" in capsys.readouterr().err and not out.exists()
 
 
-def test_run_set_changes_the_scene(capsys):
+def test_run_set_changes_the_scene_and_says_so(capsys):
     assert main(["run", "model_i", "--set", "absorber.mass=500", "--set", "contact.gap=0.04", "--end-time", "1",
                  "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert data["max_barrel_displacement"] == simulate(model_i(500.0, 0.04), 1.0).max_barrel_displacement
+    assert data["scene"] == f"{model_i().name}, with absorber.mass=500, contact.gap=0.04"
+    assert main(["run", "model_i", "--set", "absorber.mass=500", "--set", "name=light", "--end-time", "1",
+                 "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["scene"] == "light"
 
 
 @pytest.mark.parametrize("command", ["run", "validate"])
