@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 import multiprocessing
+import os
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from typing import Callable, Iterable, Sequence, TypeVar
@@ -27,7 +28,7 @@ from typing import Callable, Iterable, Sequence, TypeVar
 from ..engine.accuracy import SolverSettings
 from ..errors import SceneError, SimulationError
 from ..scene import Scene
-from .backends import check_workers, default_workers  # noqa: F401  (default_workers: public here before)
+from .backends import check_workers, default_workers, exit_with_parent  # noqa: F401  (default_workers: public)
 
 Progress = Callable[[int, int], None]
 T = TypeVar("T")
@@ -122,7 +123,8 @@ def parallel_map(function: Callable[[T], R], items: Sequence[T], *, workers: int
         return out
     chunk = max(1, math.ceil(len(items) / (workers * 8)))
     context = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn")
-    with ProcessPoolExecutor(max_workers=min(workers, len(items)), mp_context=context) as pool:
+    with ProcessPoolExecutor(max_workers=min(workers, len(items)), mp_context=context,
+                             initializer=exit_with_parent, initargs=(os.getpid(),)) as pool:
         for i, value in enumerate(pool.map(function, items, chunksize=chunk)):
             out.append(value)
             if progress and ((i + 1) % max(1, len(items) // 20) == 0 or i + 1 == len(items)):
