@@ -6,6 +6,10 @@ Public API (one entry point per task)::
     result = simulate(model_ii(absorber_mass=1000.0, gap=0.04), end_time=10.0)
     print(result.max_barrel_displacement)
 
+    from mbs_models import apply_overrides, run_sweep
+    lighter = apply_overrides(model_ii(), {"absorber.mass": 500.0, "contact.gap": 0.02})   # dotted keys
+    table = run_sweep(model_ii(), {"absorber.mass": [100, 1000], "contact.gap": "0:0.12:13"}, out="gaps.csv")
+
 Scenes (:mod:`.scene`) and their elements' tables (:mod:`.elements`) are imported eagerly and need no
 Exudyn; the engine (:mod:`.engine`), results (:mod:`.results`) and studies are imported on first use,
 so that scenes can be read, checked and written without ever loading Exudyn.
