@@ -15,7 +15,7 @@ searching the brackets one at a time.
 
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 

@@ -8,7 +8,7 @@ acceleration), which is fourth-order accurate in the step size.
 
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 

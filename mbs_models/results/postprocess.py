@@ -13,76 +13,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..elements.barrel import BARREL
-from .hermite import HermiteStack, HermiteTrajectory
+from .energies import Energies, cumulative_quadrature, energies  # noqa: F401  (re-exported)
 from .peaks import refine_crossing, refine_maximum
 from .refinement import Episodes, refine
 from .result import ALL_METRICS, ContactOutput, Impact
-
-# Gauss-Legendre nodes and weights on [0, 1], 3 points (exact for degree-5 polynomials).
-_GL_NODES = 0.5 + 0.5 * np.array([-np.sqrt(0.6), 0.0, np.sqrt(0.6)])
-_GL_WEIGHTS = np.array([5.0, 8.0, 5.0]) / 18.0
-
-
-@dataclass
-class Samples:
-    """Step-end samples of one solve: time (s), per body position/velocity/acceleration (m, m/s, m/s^2),
-    and the force (N) each recording connector (the contacts) had at each step end."""
-
-    time: np.ndarray
-    positions: dict[str, np.ndarray]
-    velocities: dict[str, np.ndarray]
-    accelerations: dict[str, np.ndarray]
-    forces: dict[str, np.ndarray] = field(default_factory=dict)
-
-
-class Interpolant:
-    """Hermite interpolation of every body's state between samples.
-
-    ``x[name]``, ``v[name]``: one body's position and velocity; :meth:`state` and :meth:`on_intervals`
-    give every body's at once (one interval search and one set of basis polynomials for all; the same
-    values as the single trajectories, bit for bit).
-    """
-
-    def __init__(self, s: Samples):
-        self.time = s.time
-        self.names = list(s.positions)
-        self.x = {name: HermiteTrajectory(s.time, s.positions[name], s.velocities[name]) for name in s.positions}
-        self.v = {name: HermiteTrajectory(s.time, s.velocities[name], s.accelerations[name]) for name in s.positions}
-        self._stack = HermiteStack(s.time, np.array([s.positions[n] for n in self.names]
-                                                     + [s.velocities[n] for n in self.names]).reshape(-1, len(s.time)),
-                                   np.array([s.velocities[n] for n in self.names]
-                                            + [s.accelerations[n] for n in self.names]).reshape(-1, len(s.time)))
-
-    def _split(self, values) -> tuple[dict, dict]:
-        n = len(self.names)
-        return ({name: values[i] for i, name in enumerate(self.names)},
-                {name: values[n + i] for i, name in enumerate(self.names)})
-
-    def state(self, t) -> tuple[dict, dict]:
-        """Every body's position (m) and velocity (m/s) at times ``t`` (s, any shape)."""
-        return self._split(self._stack(t))
-
-    def on_intervals(self, fractions) -> tuple[dict, dict]:
-        """Every body's position and velocity at ``t_i + f h_i``, shape (intervals, fractions) each."""
-        return self._split(self._stack.on_intervals(fractions))
-
-    def positions(self, t) -> dict:
-        return self.state(t)[0]
-
-    def velocities(self, t) -> dict:
-        return self.state(t)[1]
-
-
-def cumulative_quadrature(t: np.ndarray, power_at_nodes: np.ndarray) -> np.ndarray:
-    """Cumulative integral (J) over the sample intervals from the power (W) at each interval's Gauss nodes."""
-    per_interval = (power_at_nodes * _GL_WEIGHTS[None, :]).sum(axis=1) * np.diff(t)
-    return np.concatenate([[0.0], np.cumsum(per_interval)])
-
-
-def connector_force_at(mechanism, connector, interp: Interpolant, t):
-    """A connector's force (N) on the interpolated state at times ``t`` (s)."""
-    x, v = interp.state(t)
-    return connector.force(mechanism.relative(connector, x), mechanism.relative(connector, v), t)
+from .samples import Interpolant, Samples
 
 
 def contact_episodes(mechanism, connector, s: Samples, force: np.ndarray, interp: Interpolant,
@@ -99,75 +34,6 @@ def find_impacts(mechanism, connector, s: Samples, force: np.ndarray, interp: In
     episodes = contact_episodes(mechanism, connector, s, force, interp, threshold)
     return (episodes.impacts(connector.name),
             episodes.impacts(connector.name, episodes.peak_force > threshold))
-
-
-@dataclass
-class Energies:
-    """Energy histories at the samples (J): kinetic per body, stored and dissipated per connector, and the
-    work done on the mechanism by each external input (a load by its name, the shots of a burst by
-    their element's name).  ``kinetic + stored + dissipated - work`` stays the initial energy."""
-
-    kinetic: dict[str, np.ndarray]
-    stored: dict[str, np.ndarray]
-    dissipated: dict[str, np.ndarray]
-    work: dict[str, np.ndarray] = field(default_factory=dict)
-
-    @property
-    def kinetic_total(self) -> np.ndarray:
-        return _sum(self.kinetic.values())
-
-    @property
-    def stored_total(self) -> np.ndarray:
-        return _sum(self.stored.values())
-
-
-def _sum(arrays) -> np.ndarray | None:
-    total = None
-    for array in arrays:
-        total = array if total is None else total + array
-    return total
-
-
-def energies(mechanism, s: Samples, interp: Interpolant) -> Energies:
-    """Kinetic energy per body, stored and dissipated energy per connector, in J at the samples.
-
-    Dissipated energies are integrated with 3-point Gauss quadrature on the Hermite-interpolated state
-    in every step (each connector's own :meth:`~mbs_models.elements.connector.Connector.dissipated_energy`:
-    ``c d'^2`` for a damper, ``F p' - dU/dt`` for a contact).
-    """
-    t = s.time
-    nodes_t = t[:-1, None] + _GL_NODES[None, :] * np.diff(t)[:, None]
-    x_nodes, v_nodes = interp.on_intervals(_GL_NODES)
-    kinetic = {body.name: 0.5 * body.mass * s.velocities[body.name] ** 2 for body in mechanism.bodies}
-    stored: dict[str, np.ndarray] = {}
-    dissipated: dict[str, np.ndarray] = {}
-
-    def quadrature(power):
-        return cumulative_quadrature(t, power)
-
-    for connector in mechanism.connectors:
-        samples = None
-        if connector.stores_energy:
-            samples = connector.stored_energy(mechanism.relative(connector, s.positions))
-            stored[connector.name] = samples
-        if connector.dissipates:
-            dissipated[connector.name] = connector.dissipated_energy(
-                quadrature, mechanism.relative(connector, x_nodes), mechanism.relative(connector, v_nodes),
-                nodes_t, samples)
-    work: dict[str, np.ndarray] = {}
-    for load in mechanism.loads:
-        work[load.name] = load.work(quadrature, s.positions[load.body], v_nodes[load.body], nodes_t)
-    for t_shot, body, _ in mechanism.impulses:
-        jump = np.flatnonzero((t[:-1] == t_shot) & (t[1:] == t_shot))
-        if not len(jump):
-            continue  # after the end of the window (an early stop)
-        j = int(jump[0]) + 1  # the sample after the velocity jump
-        mass = mechanism.bodies[mechanism.body_index[body]].mass
-        gain = 0.5 * mass * (s.velocities[body][j] ** 2 - s.velocities[body][j - 1] ** 2)
-        name = mechanism.impulse_element[(t_shot, body)]
-        history = work.setdefault(name, np.zeros_like(t))
-        history[j:] += gain
-    return Energies(kinetic, stored, dissipated, work)
 
 
 @dataclass

@@ -9,8 +9,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from mbs_models.results.nested_grids import first_true, first_true_search, function_maxima, maxima_search, run, \
-    uniform_grids
+from mbs_models.results.nested_grids import (
+    first_true,
+    first_true_search,
+    function_maxima,
+    maxima_search,
+    run,
+    uniform_grids,
+)
 
 
 def one_bracket_maximum(f, lo, hi, points=65, levels=4):
@@ -80,7 +86,7 @@ def test_function_maxima_find_a_known_peak():
 
 def test_first_true_equals_the_one_bracket_search(brackets):
     lo, hi = brackets
-    indicator = lambda t: wiggly(t) > 0.2  # noqa: E731  (flips many times in the wide brackets)
+    indicator = lambda t: wiggly(t) > 0.2
     found = first_true(indicator, lo, hi)
     for i in range(len(lo)):
         assert found[i] == one_bracket_crossing(indicator, lo[i], hi[i]), i

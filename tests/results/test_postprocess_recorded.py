@@ -11,6 +11,7 @@ scalar code's floating-point operations element by element, so the comparison is
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import math
 from pathlib import Path
@@ -20,8 +21,6 @@ import pytest
 from mbs_models import load_scene, model_i, model_ii, simplified_model, simulate
 from mbs_models.scenes import scene_path
 from validation.studies.hard_cases import FAST_CASES, HARD_CASES_BY_NAME
-
-import importlib.util
 
 _spec = importlib.util.spec_from_file_location(
     "record_postprocess_baseline", Path(__file__).resolve().parents[2] / "scripts" / "record_postprocess_baseline.py")
