@@ -13,6 +13,8 @@ same floating-point operations, in the same order, as :func:`hermite` does for o
 
 from __future__ import annotations
 
+from contextlib import nullcontext
+
 import numpy as np
 
 
@@ -25,16 +27,23 @@ def hermite(t0, t1, y0, y1, dy0, dy1, t):
             + (-2 * s3 + 3 * s2) * y1 + (s3 - s2) * h * dy1)
 
 
-def _combine(t0, t1, t, y0, y1, dy0, dy1):
-    """:func:`hermite` with the basis computed once and broadcast over leading axes of the values."""
+def _basis(t0, t1, t):
+    """The four basis polynomials of :func:`hermite` at ``t``, the derivative ones times h."""
     h = t1 - t0
     s = (t - t0) / h
     s2, s3 = s * s, s * s * s
-    b0 = 2 * s3 - 3 * s2 + 1
-    b1 = (s3 - 2 * s2 + s) * h
-    b2 = -2 * s3 + 3 * s2
-    b3 = (s3 - s2) * h
+    return 2 * s3 - 3 * s2 + 1, (s3 - 2 * s2 + s) * h, -2 * s3 + 3 * s2, (s3 - s2) * h
+
+
+def _apply(basis, y0, y1, dy0, dy1):
+    """``b0 y0 + b1 dy0 + b2 y1 + b3 dy1``, summed in :func:`hermite`'s order."""
+    b0, b1, b2, b3 = basis
     return b0 * y0 + b1 * dy0 + b2 * y1 + b3 * dy1
+
+
+def _combine(t0, t1, t, y0, y1, dy0, dy1):
+    """:func:`hermite` with the basis computed once and broadcast over leading axes of the values."""
+    return _apply(_basis(t0, t1, t), y0, y1, dy0, dy1)
 
 
 class HermiteStack:
@@ -60,16 +69,22 @@ class HermiteStack:
         """Values at ``t_i + f h_i`` for every interval i and fraction f: shape (Q, intervals, fractions).
 
         On a zero-length interval (a jump at a segment boundary, e.g. a shot) the value before the jump.
+        The basis is computed once with the intervals as the last axis (long inner loops), each quantity
+        on it in turn (small temporaries: one (Q, intervals, fractions) array of temporaries costs more
+        in fresh memory pages than in arithmetic), then laid out as (intervals, fractions).
         """
-        t0, t1 = self.time[:-1, None], self.time[1:, None]
-        f = np.asarray(fractions, dtype=float)[None, :]
-        y0, y1 = self.y[:, :-1, None], self.y[:, 1:, None]
-        dy0, dy1 = self.dy[:, :-1, None], self.dy[:, 1:, None]
-        if np.all(t1 > t0):
-            return _combine(t0, t1, t0 + f * (t1 - t0), y0, y1, dy0, dy1)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            values = _combine(t0, t1, t0 + f * (t1 - t0), y0, y1, dy0, dy1)
-        return np.where(t1 > t0, values, y0)
+        t0, t1 = self.time[:-1], self.time[1:]
+        f = np.asarray(fractions, dtype=float)[:, None]
+        jump = not np.all(t1 > t0)
+        with np.errstate(invalid="ignore", divide="ignore") if jump else nullcontext():
+            basis = _basis(t0, t1, t0 + f * (t1 - t0))
+        out = np.empty((len(self.y), len(t0), f.shape[0]))
+        for q in range(len(self.y)):
+            values = _apply(basis, self.y[q, :-1], self.y[q, 1:], self.dy[q, :-1], self.dy[q, 1:])
+            if jump:
+                values = np.where(t1 > t0, values, self.y[q, :-1])
+            out[q] = values.T
+        return out
 
 
 class HermiteTrajectory:
