@@ -46,9 +46,10 @@ def scene_of(key: str):
 
 
 def differences(new, old, path="") -> list[str]:
-    """Where two recorded structures differ (floats as float.hex: exact)."""
+    """Where two recorded structures differ (floats as float.hex: exact).  Keys added to the outputs
+    since the recording (new metrics) are not compared; every recorded key must be there."""
     if isinstance(old, dict) and isinstance(new, dict):
-        out = [f"{path}: keys {sorted(set(new) ^ set(old))}"] if set(new) != set(old) else []
+        out = [f"{path}: missing keys {sorted(set(old) - set(new))}"] if set(old) - set(new) else []
         for key in old:
             if key in new:
                 out += differences(new[key], old[key], f"{path}/{key}")
