@@ -53,14 +53,14 @@ def maxima_search(lo: np.ndarray, hi: np.ndarray, points: int = 65, levels: int 
         j = np.argmax(values, axis=1)
         lo, hi = grid[rows, np.maximum(j - 1, 0)], grid[rows, np.minimum(j + 1, points - 1)]
     best_value, best_time = values[rows, j], grid[rows, j]
-    inner = (j > 0) & (j < points - 1)
-    jj = np.where(inner, j, 1)
-    y0, y1, y2 = values[rows, jj - 1], values[rows, jj], values[rows, jj + 1]
+    inner = rows[(j > 0) & (j < points - 1)]  # the best point has two neighbours
+    ji = j[inner]
+    y0, y1, y2 = values[inner, ji - 1], values[inner, ji], values[inner, ji + 1]
     curvature = y0 - 2 * y1 + y2
-    vertex = inner & (curvature < 0)
+    vertex = curvature < 0
     if vertex.any():
-        r = rows[vertex]
-        shift = 0.5 * (y0[r] - y2[r]) / curvature[r]
+        r = inner[vertex]
+        shift = 0.5 * (y0[vertex] - y2[vertex]) / curvature[vertex]
         step = grid[r, 1] - grid[r, 0]
         t_vertex = grid[r, j[r]] + shift * step
         value = np.asarray((yield t_vertex), dtype=float)
