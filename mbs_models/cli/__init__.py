@@ -18,6 +18,7 @@ from .. import __version__
 from ..errors import SceneError, SimulationError
 from ..scene import load_scene
 from . import run
+from .sweep import add_set_argument, add_sweep_parser, apply_sets
 
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
 #: What the accuracy presets mean (mbs_models.engine.accuracy.ACCURACY_PRESETS: the worst relative error of
@@ -77,7 +78,7 @@ def _cmd_paper(args) -> int:
 def _cmd_validate(args) -> int:
     from validation.studies.compare import compare
 
-    scene = _resolve_scene(args.scene)
+    scene = apply_sets(_resolve_scene(args.scene), args.set)
     run.warn_out_of_reach(scene)
     comparison = compare(scene, args.end_time, args.accuracy, impact_threshold=args.impact_threshold)
     if args.json:
@@ -183,6 +184,7 @@ def build_parser() -> argparse.ArgumentParser:
     validate.add_argument("--impact-threshold", type=float, default=1000.0,
                           help="peak force (N) above which a contact episode counts as an impact (default 1000)")
     validate.add_argument("--json", action="store_true", help="print the comparison as JSON")
+    add_set_argument(validate)
     validate.set_defaults(handler=_cmd_validate)
 
     paper = sub.add_parser("paper", help="reproduce the paper: Table 2 and the figures")
@@ -224,6 +226,7 @@ def build_parser() -> argparse.ArgumentParser:
                         help=ACCURACY_HELP)
     design.add_argument("--json", action="store_true", help="print the comparison as JSON")
     design.set_defaults(handler=_cmd_design_brake)
+    add_sweep_parser(sub)
     return parser
 
 

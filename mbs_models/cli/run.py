@@ -13,6 +13,8 @@ import sys
 
 def add_parser(sub, accuracy_help: str) -> None:
     """The ``run`` subcommand's arguments."""
+    from .sweep import add_set_argument
+
     run = sub.add_parser("run", help="simulate one scene and print its metrics")
     run.add_argument("scene", help="scene TOML file, or the name of a shipped scene (see the README: model_i, "
                                    "model_ii, two_absorbers, ...)")
@@ -30,6 +32,7 @@ def add_parser(sub, accuracy_help: str) -> None:
                      help="user-function backend (default symbolic; python is slower, for debugging)")
     run.add_argument("--impact-threshold", type=float, default=1000.0,
                      help="peak force (N) above which a contact episode counts as an impact (default 1000)")
+    add_set_argument(run)
     run.set_defaults(handler=command)
 
 
@@ -45,8 +48,9 @@ def command(args) -> int:
     from ..engine.simulation import simulate
     from ..outputs import check_output_file
     from . import EXIT_OK, _resolve_scene
+    from .sweep import apply_sets
 
-    scene = _resolve_scene(args.scene)
+    scene = apply_sets(_resolve_scene(args.scene), args.set)
     if args.plot:
         from ..results.plotting import figure_format
         figure_format(args.plot, key="--plot")
