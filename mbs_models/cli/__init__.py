@@ -241,6 +241,9 @@ def build_parser() -> argparse.ArgumentParser:
     design.add_argument("--accuracy", default="standard", choices=("draft", "standard", "reference"))
     design.add_argument("--json", action="store_true", help="print the comparison as JSON")
     design.set_defaults(handler=_cmd_design_brake)
+
+    from .plot_sweep import add_parser as add_plot_sweep
+    add_plot_sweep(sub)
     return parser
 
 
