@@ -16,8 +16,8 @@ from __future__ import annotations
 import importlib
 
 from .errors import RecoilError, SceneError, SimulationError
-from .scene import (TABLE_CLASSES, Conventions, Scene, load_scene, model_i, model_ii, paper_model, scene_from_dict,
-                    scene_to_dict, scene_to_toml, simplified_model)
+from .scene import (TABLE_CLASSES, Conventions, Scene, apply_overrides, load_scene, model_i, model_ii, paper_model, scene_from_dict,
+                    parse_spec, scene_to_dict, scene_to_toml, simplified_model)
 
 globals().update(TABLE_CLASSES)  # Barrel, RecoilSpring, Absorber, Contact, ...: every element's table
 
@@ -47,7 +47,7 @@ _LAZY = {
 __all__ = [
     *TABLE_CLASSES, "Conventions", "Scene",
     "RecoilError", "SceneError", "SimulationError",
-    "load_scene", "scene_from_dict", "scene_to_dict", "scene_to_toml",
+    "load_scene", "scene_from_dict", "scene_to_dict", "scene_to_toml", "apply_overrides", "parse_spec",
     "model_i", "model_ii", "paper_model", "simplified_model",
     *_LAZY,
 ]
