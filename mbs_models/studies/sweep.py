@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import math
 import multiprocessing
-import os
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from typing import Callable, Iterable, Sequence, TypeVar
@@ -20,6 +19,7 @@ from typing import Callable, Iterable, Sequence, TypeVar
 from ..engine.accuracy import SolverSettings
 from ..errors import SceneError, SimulationError
 from ..scene import Scene
+from .backends import check_workers, default_workers  # noqa: F401  (default_workers: public here before)
 
 Progress = Callable[[int, int], None]
 T = TypeVar("T")
@@ -55,11 +55,11 @@ class SweepPoint:
 
 
 def _run_one(job: tuple[Scene, float, str | SolverSettings, tuple[str, ...]]) -> SweepPoint:
-    from ..engine.simulation import simulate
+    from .point import PointSettings, simulate_scene
 
     scene, end_time, accuracy, stop_when_final = job
     try:
-        result = simulate(scene, end_time, accuracy, stop_when_final=stop_when_final)
+        result = simulate_scene(scene, PointSettings(end_time, accuracy, stop_when_final))
     except SimulationError as exc:
         return SweepPoint(scene, None, None, None, None, None, 0.0, error=str(exc))
     return SweepPoint(scene, result.max_barrel_displacement, result.time_of_max_barrel_displacement,
@@ -69,15 +69,7 @@ def _run_one(job: tuple[Scene, float, str | SolverSettings, tuple[str, ...]]) ->
                       peak_support_force=result.peak_support_force)
 
 
-def default_workers() -> int:
-    """Worker processes to use: the CPUs available to this process."""
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except AttributeError:  # pragma: no cover - not Linux
-        return max(1, os.cpu_count() or 1)
-
-
-def run_sweep(scenes: Sequence[Scene], end_time: float = 10.0, accuracy: str | SolverSettings = "standard", *,
+def run_scenes(scenes: Sequence[Scene], end_time: float = 10.0, accuracy: str | SolverSettings = "standard", *,
               workers: int | None = None, progress: Progress | None = None,
               stop_when_final: Sequence[str] = ()) -> list[SweepPoint]:
     """Simulate every scene (in order) and return one :class:`SweepPoint` each.
@@ -112,9 +104,7 @@ def parallel_map(function: Callable[[T], R], items: Sequence[T], *, workers: int
     are not).  ``workers=1`` (or a single item) runs in this process.
     """
     items = list(items)
-    workers = default_workers() if workers is None else workers
-    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
-        raise SceneError("workers", f"must be a whole number >= 1, got {workers!r}")
+    workers = check_workers(workers)
     out: list[R] = []
     if workers == 1 or len(items) <= 1:
         for i, item in enumerate(items):
@@ -138,8 +128,8 @@ def gap_sweep(factory: Callable[..., Scene], absorber_mass: float, gaps: Iterabl
     """Max barrel displacement etc. over gaps (m) for one model factory and absorber mass (Figs 4-5).
 
     ``stop_when_final=("max_barrel_displacement",)`` gives Figs 4-5 at a fraction of the cost: the
-    same values, the other metrics None (see :func:`run_sweep`).
+    same values, the other metrics None (see :func:`run_scenes`).
     """
     scenes = [factory(absorber_mass, float(gap)) for gap in gaps]
-    return run_sweep(scenes, end_time, accuracy, workers=workers, progress=progress,
+    return run_scenes(scenes, end_time, accuracy, workers=workers, progress=progress,
                      stop_when_final=stop_when_final)

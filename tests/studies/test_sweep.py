@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from mbs_models import Conventions, SceneError, model_i, model_ii, simulate
-from mbs_models.studies.sweep import gap_sweep, parallel_map, run_sweep
+from mbs_models.studies.sweep import gap_sweep, parallel_map, run_scenes
 
 
 def test_parallel_gap_sweep_equals_serial_simulate():
@@ -21,7 +21,7 @@ def test_parallel_gap_sweep_equals_serial_simulate():
 
 def test_failed_point_carries_its_reason_and_does_not_stop_the_sweep():
     scenes = [model_ii(1000.0, 0.0), model_ii(1000.0, 0.0, Conventions(compression_only=True))]
-    points = run_sweep(scenes, end_time=0.5, workers=1)
+    points = run_scenes(scenes, end_time=0.5, workers=1)
     assert points[0].error is None and points[0].max_barrel_displacement > 0
     assert points[1].max_barrel_displacement is None and "step budget" in points[1].error
 
@@ -34,9 +34,9 @@ def test_bad_worker_counts(workers):
 
 def test_bad_sweep_arguments_fail_fast():
     with pytest.raises(SceneError, match="end_time"):
-        run_sweep([model_i()], end_time=-1.0)
+        run_scenes([model_i()], end_time=-1.0)
     with pytest.raises(SceneError, match="scenes"):
-        run_sweep(["not a scene"])
+        run_scenes(["not a scene"])
 
 
 def test_progress_is_reported():

@@ -32,7 +32,7 @@ from mbs_models.outputs import atomic_write_json, atomic_write_text, prepare_out
 from mbs_models.results.plotting import (MODEL_COLOURS, figure_png, new_figure, plot_barrel_displacements,
                                  plot_contact_histories, plot_first_impact)
 from mbs_models.scene import Scene
-from mbs_models.studies.sweep import parallel_map, run_sweep
+from mbs_models.studies.sweep import parallel_map, run_scenes
 
 from .claims import ClaimEvidence, evaluate_claims
 from .compare import compare
@@ -152,8 +152,8 @@ def compute_report(options: ReportOptions = ReportOptions(), progress: Progress 
     gaps = np.round(np.arange(0.0, options.gap_max + 1e-12, options.gap_step), 6)
     progress(f"gap sweeps: {len(gaps)} gaps x {len(options.masses)} masses x 2 models")
     sweep_scenes = [factory(m, float(g)) for factory in (model_i, model_ii) for m in options.masses for g in gaps]
-    points = run_sweep(sweep_scenes, options.end_time, options.accuracy, workers=options.workers,
-                       progress=_counter(progress, "runs"), stop_when_final=("max_barrel_displacement",))
+    points = run_scenes(sweep_scenes, options.end_time, options.accuracy, workers=options.workers,
+                        progress=_counter(progress, "runs"), stop_when_final=("max_barrel_displacement",))
     sweeps: dict[tuple[str, float], list[tuple[float, float]]] = {}
     failures = []
     for point in points:
