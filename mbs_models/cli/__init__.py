@@ -243,7 +243,9 @@ def build_parser() -> argparse.ArgumentParser:
     design.set_defaults(handler=_cmd_design_brake)
 
     from .plot_sweep import add_parser as add_plot_sweep
+    from .optimise import add_parser as add_optimise
     add_plot_sweep(sub)
+    add_optimise(sub)
     return parser
 
 

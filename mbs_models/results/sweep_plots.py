@@ -122,13 +122,13 @@ def varied_parameters(table) -> list[str]:
     return sorted((c for c, n in counts.items() if n > 1), key=lambda c: -counts[c])
 
 
-def check_column(table, column: str, allowed: list[str], key: str) -> str:
+def check_column(column: str, allowed: list[str], key: str, what: str = "column") -> str:
     """``column`` if it is one of ``allowed``; else a SceneError naming ``key``, with "did you mean"."""
     if column in allowed:
         return column
     close = difflib.get_close_matches(column, allowed, n=1)
     hint = f"; did you mean {close[0]!r}?" if close else ""
-    raise SceneError(key, f"unknown column {column!r}{hint} (allowed: {', '.join(allowed) or 'none'})")
+    raise SceneError(key, f"unknown {what} {column!r}{hint} (allowed: {', '.join(allowed) or 'none'})")
 
 
 @dataclass
@@ -259,7 +259,7 @@ def plot_tradeoff(table, hue: str | None = None, *, title: str | None = None) ->
     and the Pareto front (the designs that cannot be improved in one without losing in the other)."""
     length, force = TRADEOFF_METRICS
     for metric in TRADEOFF_METRICS:
-        check_column(table, metric, metric_columns(table), "--y")
+        check_column(metric, metric_columns(table), "--y")
     rows, notes = usable_rows(table, [length, force] + ([hue] if hue else []))
     if rows.empty:
         raise SceneError(force, "no row of the table has both the recoil length and the peak force on the mount")
@@ -302,11 +302,11 @@ def plot_sweep(table, x: str | None = None, y: str | None = None, hue: str | Non
     if not parameters:
         raise SceneError("FILE", "the table has no parameter column (columns named by a dotted scene key)")
     if x is not None:
-        check_column(table, x, parameters, "--x")
+        check_column(x, parameters, "--x")
     if hue is not None:
-        check_column(table, hue, parameters, "--hue")
+        check_column(hue, parameters, "--hue")
     if y is not None:
-        check_column(table, y, metrics, "--y")
+        check_column(y, metrics, "--y")
     varied = varied_parameters(table)
     if kind == "tradeoff":
         return plot_tradeoff(table, hue if hue is not None else (x or (varied[0] if varied else None)))
