@@ -78,7 +78,9 @@ def add_parser(sub) -> None:
     opt.add_argument("--popsize", type=int, default=10,
                      help="population per varied parameter (default 10)")
     opt.add_argument("--maxiter", type=int, default=30, help="generations at most (default 30)")
-X
+    opt.add_argument("--tol", type=float, default=1e-4,
+                     help="stop when the population's objective spread is below this fraction of its mean "
+                          "(scipy's tol; default 1e-4)")
     opt.add_argument("--workers", type=int, default=None, help="local worker processes (default: all CPUs)")
     opt.add_argument("--scheduler", default=None, metavar="ADDRESS",
                      help="Dask scheduler tcp://HOST:PORT (instead of local processes)")

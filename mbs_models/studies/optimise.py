@@ -320,7 +320,7 @@ def optimisable_metrics(scene: Scene) -> list[str]:
 def check_problem(scene: Scene, bounds: Mapping[str, tuple[float, float]], minimise: str,
                   constraints: Sequence[str | Constraint] = (), *, end_time: float = 10.0,
                   accuracy: str = "standard", seed: int = 1, popsize: int = 10, maxiter: int = 30,
-                  tol: float = 0.01) -> tuple[dict[str, tuple[float, float]], tuple[Constraint, ...], list[str]]:
+                  tol: float = 1e-4) -> tuple[dict[str, tuple[float, float]], tuple[Constraint, ...], list[str]]:
     """Every argument of :func:`optimise` checked before any simulation: ``(bounds, constraints,
     metrics)``, or one SceneError naming the argument (or the scene key) and what is allowed."""
     from ..engine.accuracy import solver_settings_for
