@@ -53,7 +53,24 @@ def plot_optimisation(result) -> Figure:
                  + (f", {failed} failed" if failed else ""), fontsize=10)
     ax.legend(fontsize=8)
 
-    ax = axes[0, 1]
+    draw_design_space(axes[0, 1], result)
+    state = "" if result.feasible else " -- NO FEASIBLE DESIGN FOUND"
+    fig.suptitle(f"minimise {result.minimise} over {', '.join(keys)} (base scene: {result.scene.name}){state}",
+                 fontsize=11)
+    return fig
+
+
+def draw_design_space(ax, result, *, colorbar: bool = True) -> None:
+    """The evaluated points of ``result`` over its design space on ``ax``: for one parameter the
+    minimised metric against it, for two or more the plane of the first two parameters with the points
+    coloured by the metric (a colour bar beside ``ax`` if ``colorbar``); infeasible points as grey crosses,
+    the optimum as a red star; the title names the constraints."""
+    history = result.history
+    keys = list(result.bounds)
+    label, factor = metric_label(result.minimise)
+    values = history[result.minimise].to_numpy(dtype=float) * factor
+    feasible = history["feasible"].to_numpy(dtype=bool)
+    infeasible = (history["status"].to_numpy() == "ok") & ~feasible
     x_label, x_factor = parameter_label(keys[0])
     xs = history[keys[0]].to_numpy(dtype=float) * x_factor
     best_x = result.parameters[keys[0]] * x_factor
@@ -68,7 +85,8 @@ def plot_optimisation(result) -> Figure:
         y_label, y_factor = parameter_label(keys[1])
         ys = history[keys[1]].to_numpy(dtype=float) * y_factor
         points = ax.scatter(xs[feasible], ys[feasible], c=values[feasible], s=14, cmap="viridis", label="feasible")
-        fig.colorbar(points, ax=ax, label=label)
+        if colorbar:
+            ax.figure.colorbar(points, ax=ax, label=label)
         if (~feasible).any():
             ax.plot(xs[~feasible], ys[~feasible], "x", ms=4, color="#999999", label="infeasible or failed")
         ax.plot([best_x], [result.parameters[keys[1]] * y_factor], label="optimum", **OPTIMUM_STYLE)
@@ -79,7 +97,3 @@ def plot_optimisation(result) -> Figure:
     ax.legend(fontsize=8)
     constraints = ", ".join(str(c) for c in result.constraints) or "no constraints"
     ax.set_title(f"evaluated designs ({constraints})", fontsize=10)
-    state = "" if result.feasible else " -- NO FEASIBLE DESIGN FOUND"
-    fig.suptitle(f"minimise {result.minimise} over {', '.join(keys)} (base scene: {result.scene.name}){state}",
-                 fontsize=11)
-    return fig
