@@ -42,6 +42,7 @@ _LAZY = {
     "add_recoil_brake": ".elements.recoil_brake",
     "add_recuperator": ".elements.recuperator",
     "add_body": ".engine.assembly",
+    "run_sweep": ".studies.sweep",           # a grid over dotted scene keys -> a pandas table (recoil sweep)
 }
 
 __all__ = [

@@ -85,3 +85,13 @@ def test_the_files_that_know_about_an_effect_are_the_ones_listed():
     knowing = {path for path in tracked if path.endswith((".py", ".toml")) and path != "tests/test_readme.py"
                and names.search((root / path).read_text(errors="replace"))}  # (this checker names them, of course)
     assert knowing == listed
+
+
+def test_the_sweep_example_runs_and_gives_the_table(capsys):
+    """The README's run_sweep example: a 2 x 2 grid, every point ok."""
+    namespace: dict = {}
+    exec(compile(_python_block_after("### `recoil sweep`"), "README", "exec"), namespace)
+    table = namespace["table"]
+    assert len(table) == 4 and (table["status"] == "ok").all()
+    assert table["contact.gap"].tolist() == [0.0, 0.04, 0.0, 0.04]
+    assert "peak_support_force" in capsys.readouterr().out

@@ -15,6 +15,7 @@ from typing import Sequence
 
 from ..errors import SceneError, SimulationError
 from ..scene import load_scene
+from .sweep import add_set_argument, add_sweep_parser, apply_sets
 
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
 _ARGUMENT_NAMES = {"end_time": "--end-time", "accuracy": "--accuracy", "impact_threshold": "--impact-threshold",
@@ -45,7 +46,7 @@ def _resolve_scene(path: str):
 def _cmd_run(args) -> int:
     from ..engine.simulation import simulate
 
-    scene = _resolve_scene(args.scene)
+    scene = apply_sets(_resolve_scene(args.scene), args.set)
     if args.plot:
         from ..outputs import prepare_output_dir
         prepare_output_dir(Path(args.plot).parent or Path("."), key="--plot")
@@ -90,7 +91,7 @@ def _cmd_paper(args) -> int:
 def _cmd_validate(args) -> int:
     from validation.studies.compare import compare
 
-    scene = _resolve_scene(args.scene)
+    scene = apply_sets(_resolve_scene(args.scene), args.set)
     comparison = compare(scene, args.end_time, args.accuracy, impact_threshold=args.impact_threshold)
     if args.json:
         print(json.dumps(comparison.to_dict(), indent=2, allow_nan=False))
@@ -193,6 +194,7 @@ def build_parser() -> argparse.ArgumentParser:
                      help="user-function backend (default symbolic; python is slower, for debugging)")
     run.add_argument("--impact-threshold", type=float, default=1000.0,
                      help="peak force (N) above which a contact episode counts as an impact (default 1000)")
+    add_set_argument(run)
     run.set_defaults(handler=_cmd_run)
 
     validate = sub.add_parser("validate", help="engine vs the independent scipy reference for one scene "
@@ -202,6 +204,7 @@ def build_parser() -> argparse.ArgumentParser:
     validate.add_argument("--accuracy", default="standard", choices=("draft", "standard", "reference"))
     validate.add_argument("--impact-threshold", type=float, default=1000.0, help="impact threshold in N")
     validate.add_argument("--json", action="store_true", help="print the comparison as JSON")
+    add_set_argument(validate)
     validate.set_defaults(handler=_cmd_validate)
 
     paper = sub.add_parser("paper", help="reproduce the paper: Table 2 and the figures")
@@ -241,6 +244,7 @@ def build_parser() -> argparse.ArgumentParser:
     design.add_argument("--accuracy", default="standard", choices=("draft", "standard", "reference"))
     design.add_argument("--json", action="store_true", help="print the comparison as JSON")
     design.set_defaults(handler=_cmd_design_brake)
+    add_sweep_parser(sub)
 
     from .plot_sweep import add_parser as add_plot_sweep
     from .optimise import add_parser as add_optimise

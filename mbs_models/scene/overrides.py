@@ -240,12 +240,13 @@ def parse_value(text: str, key: str = "") -> Any:
     return value
 
 
-def parse_assignment(text: str, what: str = "--set") -> tuple[str, str]:
+def parse_assignment(text: str, what: str = "--set", example: str = "KEY=VALUE (e.g. contact.gap=0.01)"
+                     ) -> tuple[str, str]:
     """``"KEY=VALUE"`` -> ``(KEY, VALUE)`` (both stripped), or a SceneError naming ``what``."""
     key, sep, value = text.partition("=")
     key, value = key.strip(), value.strip()
     if not sep or not key:
-        raise SceneError(what, f"expected KEY=VALUE (e.g. contact.gap=0.01), got {text!r}")
+        raise SceneError(what, f"expected {example}, got {text!r}")
     if not value:
         raise SceneError(key, "no value given after '='")
     return key, value

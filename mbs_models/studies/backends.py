@@ -105,10 +105,11 @@ class DaskBackend(SerialBackend):
             self.client, self._own = scheduler, False
         elif isinstance(scheduler, str) and scheduler.strip():
             try:
-                self.client = distributed.Client(scheduler.strip(), timeout=timeout, set_as_default=False)
+                self.client = distributed.Client(scheduler.strip(), timeout=timeout)
             except (OSError, TimeoutError, ValueError) as exc:
+                reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
                 raise SceneError("scheduler", f"cannot connect to the Dask scheduler at {scheduler!r}: "
-                                              f"{str(exc).splitlines()[0] if str(exc) else type(exc).__name__}") from None
+                                              f"{reason}") from None
             self._own = True
         else:
             raise SceneError("scheduler", f"must be an address tcp://HOST:PORT or a dask.distributed.Client, "

@@ -33,7 +33,7 @@ SCALAR_METRICS = (
 )
 #: Per absorber (scenes with several), as ``absorber.N.<metric>``.
 ABSORBER_METRICS = ("peak_contact_force", "max_absorber_velocity", "impacts")
-#: Per end stop (``recoil_stop``, ``battery_stop``), as ``<stop>.<metric>``.
+#: Per end stop (a contact with the ground that is no absorber), as ``<element name>.<metric>``.
 STOP_METRICS = ("peak_contact_force", "impacts", "dissipated_energy")
 #: Run information after the metrics: the barrel's initial velocity (m/s), the simulated end time (s, less
 #: than asked with an early stop), why the run ended, the solver's steps.
@@ -71,7 +71,8 @@ def _stops(scene: Scene) -> list[str]:
     from ..elements.absorber import Absorber
     from ..elements.contact_laws import LawFields
 
-    return [name for name, table in scene.elements() if isinstance(table, LawFields) and not isinstance(table, Absorber)]
+    return [name for name, table in scene.elements()
+            if isinstance(table, LawFields) and not isinstance(table, Absorber)]
 
 
 def metric_columns(scene: Scene) -> list[str]:
@@ -124,7 +125,8 @@ def evaluate_point(scene: Scene, overrides: Mapping[str, Any], settings: PointSe
     return row
 
 
-def evaluate_batch(task: tuple[Scene, PointSettings, Sequence[tuple[int, Mapping[str, Any]]]]) -> list[tuple[int, dict]]:
+def evaluate_batch(task: tuple[Scene, PointSettings, Sequence[tuple[int, Mapping[str, Any]]]]
+                   ) -> list[tuple[int, dict]]:
     """``[(index, evaluate_point(scene, overrides, settings)) for index, overrides in points]``: the unit of
     work a backend sends to a worker (several points per task amortise its overhead)."""
     scene, settings, points = task

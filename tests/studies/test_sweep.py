@@ -1,11 +1,19 @@
-"""Parallel sweeps (mbs_models.studies.sweep): same numbers as serial runs, failures kept per point."""
+"""Sweeps (mbs_models.studies.sweep): run_sweep's grids (the numbers of single runs whichever backend runs them,
+resuming, failures kept per point) and the scene lists of run_scenes/gap_sweep/parallel_map."""
 
 from __future__ import annotations
 
+import os
+import signal
+
+import pandas as pd
 import pytest
 
+import mbs_models
 from mbs_models import Conventions, SceneError, model_i, model_ii, simulate
-from mbs_models.studies.sweep import gap_sweep, parallel_map, run_scenes
+from mbs_models.studies import point as point_module
+from mbs_models.studies.point import SCALAR_METRICS
+from mbs_models.studies.sweep import gap_sweep, parallel_map, run_scenes, run_sweep
 
 
 def test_parallel_gap_sweep_equals_serial_simulate():
@@ -43,3 +51,190 @@ def test_progress_is_reported():
     calls = []
     parallel_map(abs, [-1, -2, -3], workers=1, progress=lambda done, total: calls.append((done, total)))
     assert calls == [(1, 3), (2, 3), (3, 3)]
+
+
+# ================================================================================================ run_sweep: grids
+FIG_GRID = {"absorber.mass": [100.0, 1000.0], "contact.gap": [0.0, 0.04, 0.08]}  # Figs 4/5, reduced
+
+
+def _values(table: pd.DataFrame) -> pd.DataFrame:
+    """The table without its wall times (the only column that differs between two runs of a point)."""
+    return table.drop(columns="wall_time")
+
+
+def _assert_file_holds(path, table: pd.DataFrame) -> None:
+    """The CSV file holds ``table`` in its order (read as plain CSV; wall times aside)."""
+    written = pd.read_csv(path, keep_default_na=False, na_values=[""])
+    assert list(written.columns) == list(table.columns)
+    for column in table.columns:
+        if column != "wall_time":
+            left = written[column].astype(object).where(written[column].notna(), None).tolist()
+            right = table[column].astype(object).where(table[column].notna(), None).tolist()
+            assert left == right, column
+
+
+def test_run_sweep_is_the_public_entry_point():
+    assert mbs_models.run_sweep is run_sweep
+
+
+@pytest.mark.parametrize("factory", [model_i, model_ii], ids=["model_i", "model_ii"])
+def test_rows_equal_single_simulate_runs_point_by_point(factory):
+    table = run_sweep(factory(), FIG_GRID, end_time=2.0, workers=2, progress=False)
+    assert len(table) == 6 and (table["status"] == "ok").all() and table["error"].isna().all()
+    for row, (mass, gap) in zip(table.to_dict("records"), [(m, g) for m in (100.0, 1000.0) for g in (0.0, 0.04, 0.08)]):
+        assert (row["absorber.mass"], row["contact.gap"]) == (mass, gap)
+        result = simulate(factory(mass, gap), 2.0)
+        for name in SCALAR_METRICS:
+            expected = len(result.impacts) if name == "impacts" else getattr(result, name)
+            assert row[name] == expected or (expected is None and pd.isna(row[name])), (name, mass, gap)
+
+
+def test_serial_equals_local_parallel(tmp_path):
+    serial = run_sweep(model_ii(), FIG_GRID, end_time=1.0, workers=1, progress=False)
+    parallel = run_sweep(model_ii(), FIG_GRID, end_time=1.0, workers=2, batch_size=1, progress=False,
+                         out=tmp_path / "p.csv")
+    pd.testing.assert_frame_equal(_values(serial), _values(parallel))
+    _assert_file_holds(tmp_path / "p.csv", serial)
+
+
+def test_a_failing_point_is_a_row_and_the_sweep_goes_on(tmp_path):
+    table = run_sweep(model_ii(1000.0, 0.0), {"conventions.compression_only": [False, True]}, end_time=0.5,
+                      workers=1, progress=False, out=tmp_path / "f.csv")
+    assert table["status"].tolist() == ["ok", "SimulationError"]
+    assert "step budget" in table["error"][1] and pd.isna(table["max_barrel_displacement"][1])
+    assert table["max_barrel_displacement"][0] > 0
+    assert table.attrs["sweep"]["failed"] == 1
+    invalid = run_sweep(model_i(), {"contact.law": ["hunt-crossley", "flores"], "contact.restitution": [0.5]},
+                        end_time=0.5, workers=1, progress=False)
+    assert invalid["status"].tolist() == ["SceneError", "ok"]
+    assert invalid["error"][0].startswith("contact.restitution: not a field of law 'hunt-crossley'")
+
+
+def test_resumed_after_a_cut_file_equals_uninterrupted(tmp_path):
+    path = tmp_path / "s.csv"
+    full = run_sweep(model_i(), FIG_GRID, end_time=1.0, workers=1, progress=False, out=path)
+    lines = path.read_text().splitlines(keepends=True)
+    path.write_text("".join(lines[:3]) + lines[3][:10])   # two rows kept, the third cut mid-line (a kill)
+    resumed = run_sweep(model_i(), FIG_GRID, end_time=1.0, workers=2, progress=False, out=path)
+    assert resumed.attrs["sweep"]["resumed"] == 2 and resumed.attrs["sweep"]["run"] == 4
+    pd.testing.assert_frame_equal(_values(resumed), _values(full))
+    assert resumed["wall_time"][:2].tolist() == full["wall_time"][:2].tolist()   # the kept rows come from the file
+    again = run_sweep(model_i(), FIG_GRID, end_time=1.0, progress=False, out=path)
+    assert again.attrs["sweep"]["run"] == 0
+    pd.testing.assert_frame_equal(again, resumed)
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".parquet"])
+def test_interrupted_and_resumed_equals_uninterrupted(tmp_path, monkeypatch, suffix):
+    uninterrupted = run_sweep(model_ii(), FIG_GRID, end_time=1.0, workers=1, progress=False)
+    calls = []
+    evaluate = point_module.evaluate_point
+
+    def interrupted_after_three(*args, **kwargs):
+        if len(calls) == 3:
+            raise KeyboardInterrupt
+        calls.append(1)
+        return evaluate(*args, **kwargs)
+
+    monkeypatch.setattr(point_module, "evaluate_point", interrupted_after_three)
+    path = tmp_path / f"s{suffix}"
+    with pytest.raises(KeyboardInterrupt):
+        run_sweep(model_ii(), FIG_GRID, end_time=1.0, workers=1, batch_size=1, progress=False, out=path)
+    monkeypatch.setattr(point_module, "evaluate_point", evaluate)
+    written = pd.read_csv(path) if suffix == ".csv" else pd.read_parquet(path)
+    assert len(written) == 3
+    resumed = run_sweep(model_ii(), FIG_GRID, end_time=1.0, workers=1, progress=False, out=path)
+    assert resumed.attrs["sweep"]["resumed"] == 3
+    pd.testing.assert_frame_equal(_values(resumed), _values(uninterrupted))
+
+
+def test_a_file_of_other_points_is_not_resumed(tmp_path):
+    path = tmp_path / "s.csv"
+    run_sweep(model_i(), {"contact.gap": [0.0]}, end_time=0.2, workers=1, progress=False, out=path)
+    with pytest.raises(SceneError, match="not in this sweep") as info:
+        run_sweep(model_i(), {"contact.gap": [0.01]}, end_time=0.2, workers=1, progress=False, out=path)
+    assert info.value.key == "out"
+
+
+@pytest.mark.parametrize("params, kwargs, key", [
+    ({"contact.gapp": [0.0]}, {}, "contact.gapp"),
+    ({"contact.gap": "0:1"}, {}, "contact.gap"),
+    ({"contact.gap": [-1.0]}, {}, "contact.gap"),
+    ({"contact.gap": [0.0]}, {"end_time": -1.0}, "end_time"),
+    ({"contact.gap": [0.0]}, {"accuracy": "best"}, "accuracy"),
+    ({"contact.gap": [0.0]}, {"workers": 0}, "workers"),
+    ({"contact.gap": [0.0]}, {"batch_size": 0}, "batch_size"),
+    ({"contact.gap": [0.0]}, {"stop_when_final": ("max_barrel",)}, "stop_when_final"),
+])
+def test_bad_input_raises_before_anything_is_written(tmp_path, params, kwargs, key):
+    path = tmp_path / "s.csv"
+    with pytest.raises(SceneError) as info:
+        run_sweep(model_i(), params, out=path, progress=False, **kwargs)
+    assert info.value.key == key and "\n" not in str(info.value)
+    assert not path.exists()
+
+
+def test_progress_callback():
+    calls = []
+    run_sweep(model_i(), {"contact.gap": [0.0, 0.01, 0.02]}, end_time=0.2, workers=1, batch_size=1,
+              progress=lambda done, total: calls.append((done, total)))
+    assert calls == [(1, 3), (2, 3), (3, 3)]
+
+
+def test_stop_when_final_reaches_the_points():
+    table = run_sweep(model_i(), {"contact.gap": [0.0, 0.04]}, end_time=4.0, workers=1, progress=False,
+                      stop_when_final=("max_barrel_displacement",))
+    for row in table.to_dict("records"):
+        result = simulate(model_i(1000.0, row["contact.gap"]), 4.0, stop_when_final=("max_barrel_displacement",))
+        assert row["max_barrel_displacement"] == result.max_barrel_displacement
+        assert row["end_time"] == result.end_time < 4.0
+
+
+# ================================================================================================ Dask
+@pytest.fixture(scope="module")
+def dask_cluster():
+    distributed = pytest.importorskip("dask.distributed")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                  dashboard_address=None) as cluster:
+        yield cluster
+
+
+def test_dask_equals_serial(dask_cluster):
+    serial = run_sweep(model_ii(), FIG_GRID, end_time=1.0, workers=1, progress=False)
+    on_cluster = run_sweep(model_ii(), FIG_GRID, end_time=1.0, scheduler=dask_cluster.scheduler_address,
+                           progress=False)
+    pd.testing.assert_frame_equal(_values(serial), _values(on_cluster))
+
+
+def test_a_dask_worker_killed_mid_sweep_loses_no_point(dask_cluster, tmp_path):
+    from dask.distributed import Client
+
+    grid = {"absorber.mass": [100.0, 1000.0], "contact.gap": [0.0, 0.02, 0.04, 0.06, 0.08, 0.1]}
+    serial = run_sweep(model_ii(), grid, end_time=1.0, workers=1, progress=False)
+    with Client(dask_cluster) as client:
+        pids = list(client.run(os.getpid).values())
+        killed = []
+
+        def kill_one_worker(done, total):
+            if not killed:  # after the first point: the other tasks are queued on both workers
+                os.kill(pids[0], signal.SIGKILL)
+                killed.append(pids[0])
+
+        table = run_sweep(model_ii(), grid, end_time=1.0, scheduler=client, batch_size=1, progress=kill_one_worker,
+                          out=tmp_path / "k.csv")
+        assert killed and pids[0] not in client.run(os.getpid).values()   # the nanny started a new worker
+    assert table.attrs["sweep"]["run"] == 12 and (table["status"] == "ok").all()
+    pd.testing.assert_frame_equal(_values(table), _values(serial))
+    _assert_file_holds(tmp_path / "k.csv", serial)
+
+
+def test_a_tqdm_bar_on_a_terminal_only(capsys, monkeypatch):
+    grid = {"contact.gap": [0.0, 0.01]}
+    run_sweep(model_i(), grid, end_time=0.2, workers=1, batch_size=1)
+    assert capsys.readouterr().err == ""                      # not a terminal: no bar
+    monkeypatch.setattr("sys.stderr.isatty", lambda: True)
+    run_sweep(model_i(), grid, end_time=0.2, workers=1, batch_size=1)
+    err = capsys.readouterr().err
+    assert "sweep: 100%" in err and "2/2" in err and "point/s" in err   # the rate (and the time left) shown
+    run_sweep(model_i(), grid, end_time=0.2, workers=1, progress=False)
+    assert capsys.readouterr().err == ""
