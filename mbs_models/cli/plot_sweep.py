@@ -26,9 +26,12 @@ def _cmd_plot_sweep(args) -> int:
     save_figure(drawn.figure, out)
     for note in drawn.notes:
         print(f"[recoil] note: {note}", file=sys.stderr)
-    hue = f", one per {drawn.hue}" if drawn.kind == "lines" and drawn.hue else \
-        (f" coloured by {drawn.hue}" if drawn.hue else "")
-    print(f"wrote {out}: {drawn.kind} of {drawn.y} against {drawn.x}{hue} ({drawn.rows_plotted} points)")
+    if drawn.kind == "map":
+        what = f"map of {drawn.y} over {drawn.x} and {drawn.hue}"
+    else:
+        hue = (f", one per {drawn.hue}" if drawn.kind == "lines" else f" coloured by {drawn.hue}") if drawn.hue else ""
+        what = f"{drawn.kind} of {drawn.y} against {drawn.x}{hue}"
+    print(f"wrote {out}: {what} ({drawn.rows_plotted} points)")
     return 0
 
 

@@ -99,20 +99,30 @@ def read_sweep_table(path: str | Path, key: str = "FILE"):
     return table
 
 
+def is_metric_column(column: str) -> bool:
+    """A metric or bookkeeping column of a sweep row (:mod:`mbs_models.studies.point`): a scalar metric,
+    a per-absorber or per-stop metric (``absorber.0.impacts``, ``recoil_stop.peak_contact_force``), the
+    run information or the status columns."""
+    from ..studies.point import ABSORBER_METRICS, RUN_COLUMNS, SCALAR_METRICS, STATUS_COLUMNS, STOP_METRICS
+
+    known = {*SCALAR_METRICS, *ABSORBER_METRICS, *STOP_METRICS, *RUN_COLUMNS, *STATUS_COLUMNS, *BOOKKEEPING_COLUMNS}
+    return column in known or column.rsplit(".", 1)[-1] in known
+
+
 def parameter_columns(table) -> list[str]:
-    """The swept parameters: the numeric columns named by a dotted scene key, in table order."""
+    """The swept parameters: the numeric columns named by a dotted scene key (every column that is not a
+    metric, :func:`is_metric_column`), in table order."""
     import pandas as pd
 
-    return [c for c in table.columns if "." in str(c) and c not in BOOKKEEPING_COLUMNS
-            and pd.api.types.is_numeric_dtype(table[c])]
+    return [c for c in table.columns if "." in str(c) and not is_metric_column(str(c))
+            and pd.api.types.is_numeric_dtype(table[c]) and not pd.api.types.is_bool_dtype(table[c])]
 
 
 def metric_columns(table) -> list[str]:
     """The numeric metric columns (every numeric column that is not a parameter)."""
     import pandas as pd
 
-    parameters = set(parameter_columns(table))
-    return [c for c in table.columns if c not in parameters and c not in BOOKKEEPING_COLUMNS
+    return [c for c in table.columns if is_metric_column(str(c)) and c not in BOOKKEEPING_COLUMNS
             and pd.api.types.is_numeric_dtype(table[c])]
 
 
@@ -276,7 +286,8 @@ def plot_tradeoff(table, hue: str | None = None, *, title: str | None = None) ->
     else:
         ax.scatter(xs, ys, s=16, color="#1f77b4")
     front = pareto_front(ys, xs)
-    ax.plot(xs[front], ys[front], "-", color="#d62728", lw=1.2, label=f"Pareto front ({len(front)} points)")
+    ax.plot(xs[front], ys[front], "-o", color="#d62728", lw=1.2, ms=8, mfc="none", mew=1.2,
+            label=f"Pareto front ({len(front)} points)")
     ax.legend(fontsize=8)
     ax.set_xlabel(l_label)
     ax.set_ylabel(f_label)

@@ -41,6 +41,12 @@ def test_columns_are_told_apart():
     assert parameter_columns(table) == ["absorber.mass", "contact.gap"]
     assert metric_columns(table) == ["max_barrel_displacement", "peak_support_force", "impacts", "wall_time"]
     assert varied_parameters(table) == ["contact.gap", "absorber.mass"]  # most values first
+    # dotted metric columns (several absorbers, end stops) and run columns are no parameters
+    table["absorber.0.impacts"] = 1
+    table["recoil_stop.peak_contact_force"] = 2.0e4
+    table["steps"] = 100
+    assert parameter_columns(table) == ["absorber.mass", "contact.gap"]
+    assert metric_columns(table)[-3:] == ["absorber.0.impacts", "recoil_stop.peak_contact_force", "steps"]
 
 
 def test_lines_one_per_hue_in_engineering_units():
@@ -118,3 +124,22 @@ def test_read_sweep_table_errors(tmp_path):
     (tmp_path / "empty.csv").write_text("contact.gap,max_barrel_displacement\n")
     with pytest.raises(SceneError, match="no rows"):
         read_sweep_table(tmp_path / "empty.csv")
+
+
+def test_a_real_sweep_table_from_its_file(tmp_path):
+    """The table recoil sweep writes (run_sweep, read back from CSV): lines per mass, one per mass value."""
+    from mbs_models import model_i
+    from mbs_models.studies.sweep import run_sweep
+
+    out = tmp_path / "sweep.csv"
+    run_sweep(model_i(), {"absorber.mass": [500.0, 1000.0], "contact.gap": "0:0.12:4"}, end_time=2.0,
+              workers=1, out=out, progress=False, stop_when_final=("max_barrel_displacement", "peak_support_force"))
+    table = read_sweep_table(out)
+    assert parameter_columns(table) == ["absorber.mass", "contact.gap"]
+    drawn = plot_sweep(table)
+    assert (drawn.kind, drawn.x, drawn.hue, drawn.rows_plotted) == ("lines", "contact.gap", "absorber.mass", 8)
+    assert len(drawn.figure.axes[0].get_lines()) == 2
+    np.testing.assert_allclose(drawn.figure.axes[0].get_lines()[1].get_ydata(),
+                               table[table["absorber.mass"] == 1000.0]["max_barrel_displacement"] * 1e3)
+    tradeoff = plot_sweep(table, kind="tradeoff", hue="absorber.mass")
+    assert tradeoff.rows_plotted == 8 and tradeoff.hue == "absorber.mass"
