@@ -101,7 +101,7 @@ def read_sweep_table(path: str | Path, key: str = "FILE"):
 
 def is_metric_column(column: str) -> bool:
     """A metric or bookkeeping column of a sweep row (:mod:`mbs_models.studies.point`): a scalar metric,
-    a per-absorber or per-stop metric (``absorber.0.impacts``, ``recoil_stop.peak_contact_force``), the
+    a per-absorber or per-stop metric (``absorber.0.impacts``, ``<stop>.dissipated_energy``), the
     run information or the status columns."""
     from ..studies.point import ABSORBER_METRICS, RUN_COLUMNS, SCALAR_METRICS, STATUS_COLUMNS, STOP_METRICS
 
