@@ -97,7 +97,8 @@ def test_the_sweep_example_runs_and_gives_the_table(capsys):
     assert "peak_support_force" in capsys.readouterr().out
 
 
-_OPTIMISED_ROW = re.compile(r"^\| (--|model \(i\)|model \(ii\)) \| (simplified model|Table 2|gap alone, [AB]|[AB]: [^|]+) \| "
+_OPTIMISED_ROW = re.compile(r"^\| (--|model \(i\)|model \(ii\)) \| "
+                            r"(simplified model|Table 2|gap alone, [AB]|[AB]: [^|]+) \| "
                             r"(--|\d+) \| (--|\d+\.?\d*) \| (\d+\.\d\d) \| (\d+\.\d{3}) \|$")
 
 

@@ -42,7 +42,7 @@ from __future__ import annotations
 import math
 import re
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
@@ -211,7 +211,10 @@ class OptimisationResult:
             lines.append(f"  {key:32s} {v * p_factor:.6g} [{p_label.rsplit('[', 1)[-1]}")
         for c in self.constraint_values:
             state = "met" if c["satisfied"] else "VIOLATED"
-            lines.append(f"  constraint {c['constraint']:36s} value {c['value']!s:.10} ({state})")
+            c_label, c_factor = metric_label(c["metric"])
+            value = "none (failed)" if c["value"] is None else f"{c['value'] * c_factor:.6g}"
+            lines.append(f"  constraint {c['constraint']:36s} value {value} {c_label.rsplit('[', 1)[-1].rstrip(']')}"
+                         f" ({state})")
         failed = int((self.history["status"] != "ok").sum())
         lines.append(f"  {self.evaluations} evaluations ({failed} failed) in {self.generations} generations, "
                      f"{self.wall_time:.1f} s; scipy: {self.message}")
@@ -359,7 +362,8 @@ def optimise(scene: Scene, bounds: Mapping[str, tuple[float, float]], minimise: 
     initial population, stopping earlier once the standard deviation of the population's objective is
     below ``tol`` times its mean (scipy's ``tol``; the default 1e-4 is tighter than scipy's 0.01, because
     the metrics vary by only a few per cent over a design space: with 0.01 a gap search stopped after one
-    generation, 3 mm from the optimum); no gradient polish.  ``seed`` fixes the random stream (same points on any backend).
+    generation, 3 mm from the optimum); no gradient polish.  ``seed`` fixes the random stream (same points
+    on any backend).
     Each point is simulated to ``end_time`` (s) at ``accuracy``; with ``stop_when_final`` (default) a run
     ends as soon as the objective's and the constraints' metrics are proven final (when they all can be:
     :func:`early_stop_metrics`).  ``workers``/``scheduler``: the sweep's backends (local processes,
@@ -424,5 +428,6 @@ def optimise(scene: Scene, bounds: Mapping[str, tuple[float, float]], minimise: 
         evaluations=len(evaluations.rows), wall_time=time.perf_counter() - start)
 
 
-__all__ = ["optimise", "check_problem", "optimisable_metrics", "OptimisationResult", "Constraint", "parse_constraint", "parse_bound", "check_bounds",
+__all__ = ["optimise", "check_problem", "optimisable_metrics", "OptimisationResult", "Constraint", "parse_constraint",
+           "parse_bound", "check_bounds",
            "early_stop_metrics", "HISTORY_COLUMNS"]

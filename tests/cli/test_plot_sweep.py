@@ -34,7 +34,8 @@ def test_writes_png(table_file, tmp_path, capsys, extra):
 @pytest.mark.parametrize("args, text", [
     (["missing.csv", "--out", "a.png"], "no such file"),
     (["{table}", "--out", "a.pdf"], "--out: must be a .png file"),
-    (["{table}", "--out", "a.png", "--x", "contact.gapp"], "--x: unknown column 'contact.gapp'; did you mean 'contact.gap'?"),
+    (["{table}", "--out", "a.png", "--x", "contact.gapp"],
+     "--x: unknown column 'contact.gapp'; did you mean 'contact.gap'?"),
     (["{table}", "--out", "a.png", "--y", "peak_suport_force"], "did you mean 'peak_support_force'"),
     (["{table}", "--out", "a.png", "--kind", "pie"], "invalid choice"),
     (["{table}"], "--out"),

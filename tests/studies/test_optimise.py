@@ -116,7 +116,8 @@ def test_dask_backend_gives_the_same_points():
     distributed = pytest.importorskip("dask.distributed")
     serial = optimise(model_i(1000.0, 0.0), BOUNDS, "max_barrel_displacement", seed=3, popsize=4, maxiter=1,
                       workers=1)
-    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster, \
             distributed.Client(cluster) as client:
         remote = optimise(model_i(1000.0, 0.0), BOUNDS, "max_barrel_displacement", seed=3, popsize=4, maxiter=1,
                           scheduler=client)
