@@ -252,10 +252,21 @@ def parse_assignment(text: str, what: str = "--set", example: str = "KEY=VALUE (
     return key, value
 
 
+def _shortest(value: float) -> float:
+    """The shortest decimal within 4 ulp of ``value``: a range's point without the round-off of its
+    computation (``1e-4:3e-4:5`` has 0.0002, not 0.00019999999999999998; 1/3 stays 1/3)."""
+    for digits in range(1, 18):
+        candidate = float(f"{value:.{digits}g}")
+        if abs(candidate - value) <= 4 * math.ulp(value):
+            return candidate
+    return value
+
+
 def parse_spec(spec: str, key: str = "") -> list[Any]:
     """The values of a sweep parameter: ``"100,500,1000"`` (a list of TOML values), ``"0:0.12:13"``
-    (``START:STOP:COUNT``: COUNT evenly spaced numbers, both ends included) or ``"[...]"`` (a TOML array,
-    whose items may themselves be lists).  ``key`` names the parameter in errors."""
+    (``START:STOP:COUNT``: COUNT evenly spaced numbers, both ends included exactly, each point the shortest
+    decimal within 4 ulp of ``START + i (STOP - START) / (COUNT - 1)``: no round-off noise) or ``"[...]"`` (a
+    TOML array, whose items may themselves be lists).  ``key`` names the parameter in errors."""
     if not isinstance(spec, str):
         raise SceneError(key, f"must be a text spec (100,500,1000 or START:STOP:COUNT), got {spec!r}")
     text = spec.strip()
@@ -284,8 +295,7 @@ def parse_spec(spec: str, key: str = "") -> list[Any]:
             raise SceneError(key, f"COUNT of {text!r} must be a whole number >= 2 (both ends are included), "
                                   f"got {count}")
         step = (stop - start) / (count - 1)
-        values = [start + i * step for i in range(count - 1)] + [stop]
-        return values
+        return [start] + [_shortest(start + i * step) for i in range(1, count - 1)] + [stop]
     items = [item.strip() for item in text.split(",")]
     if any(not item for item in items):
         raise SceneError(key, f"an empty item in the list {text!r}")

@@ -18,6 +18,7 @@ from __future__ import annotations
 import math
 import multiprocessing
 import os
+import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any, Callable, Iterator, Sequence
@@ -45,6 +46,19 @@ def batch_size(points: int, workers: int, *, per_worker: int = 4, largest: int =
     """Points per task: about ``per_worker`` tasks per worker (so that the pool stays balanced), at most
     ``largest`` points (so that a lost worker loses little), at least 1."""
     return max(1, min(largest, math.ceil(points / (per_worker * max(1, workers)))))
+
+
+def exit_with_parent(parent: int, period: float = 1.0) -> None:
+    """In a pool's worker: a daemon thread that ends this process once ``parent`` is gone (a parent killed
+    with SIGKILL leaves its pool's workers waiting for tasks forever otherwise)."""
+    import threading
+
+    def watch():
+        while os.getppid() == parent:
+            time.sleep(period)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="exit-with-parent", daemon=True).start()
 
 
 class SerialBackend:
@@ -81,7 +95,8 @@ class ProcessBackend(SerialBackend):
             return
         methods = multiprocessing.get_all_start_methods()
         context = multiprocessing.get_context("fork" if "fork" in methods else "spawn")
-        pool = ProcessPoolExecutor(max_workers=min(self.workers, len(tasks)), mp_context=context)
+        pool = ProcessPoolExecutor(max_workers=min(self.workers, len(tasks)), mp_context=context,
+                                   initializer=exit_with_parent, initargs=(os.getpid(),))
         try:
             futures = [pool.submit(function, task) for task in tasks]
             for future in as_completed(futures):
@@ -160,4 +175,4 @@ def make_backend(workers: int | None = None, scheduler: Any = None):
 
 
 __all__ = ["BACKENDS", "SerialBackend", "ProcessBackend", "DaskBackend", "make_backend", "batch_size",
-           "default_workers", "check_workers", "import_distributed"]
+           "default_workers", "check_workers", "import_distributed", "exit_with_parent"]

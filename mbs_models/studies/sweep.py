@@ -190,6 +190,10 @@ def run_sweep(scene: Scene, params, *, end_time: float = 10.0, accuracy: str | S
     grid = make_grid(scene, params)
     if batch_size is not None and (isinstance(batch_size, bool) or not isinstance(batch_size, int) or batch_size < 1):
         raise SceneError("batch_size", f"must be a whole number >= 1, got {batch_size!r}")
+    if scheduler is None:
+        _backends.check_workers(workers)
+    elif workers is not None:
+        _backends.make_backend(workers, scheduler)  # the error: not both
     params_columns, metrics = list(grid.keys), metric_columns(scene)
     labels = grid.labels()
     points = grid.points()

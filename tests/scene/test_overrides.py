@@ -140,6 +140,13 @@ def test_specs():
     assert len(gaps) == 13 and gaps[0] == 0.0 and gaps[-1] == 0.12      # both ends exactly
     assert all(abs(g - 0.01 * i) < 1e-15 for i, g in enumerate(gaps))
     assert parse_spec("1:-1:3") == [1.0, 0.0, -1.0]
+    # the points carry no round-off of their computation: the decimals one would type
+    assert parse_spec("1e-4:3e-4:5") == [1e-4, 1.5e-4, 2e-4, 2.5e-4, 3e-4]
+    assert parse_spec("0:0.12:25")[7] == 0.035
+    thirds = parse_spec("0:1:4")
+    assert thirds[1] == pytest.approx(1 / 3, rel=1e-15, abs=0) and thirds[2] == pytest.approx(2 / 3, rel=1e-15)
+    masses = parse_spec("100:20000:40")
+    assert all(m == pytest.approx(100 + i * 19900 / 39, rel=1e-15, abs=0) for i, m in enumerate(masses))
 
 
 @pytest.mark.parametrize("spec, needle", [

@@ -56,3 +56,53 @@ def test_batch_sizes():
     assert batch_size(26, 2) == 4            # about four tasks per worker
     assert batch_size(3, 8) == 1
     assert batch_size(10_000, 2) == 16       # capped: a lost worker loses little
+
+
+def test_pool_workers_end_when_their_parent_is_killed(tmp_path):
+    """A sweep killed with SIGKILL leaves no pool worker behind waiting for tasks."""
+    import os
+    import signal
+    import subprocess
+    import time
+
+    script = tmp_path / "parent.py"
+    script.write_text(
+        "import os, time\n"
+        "from mbs_models.studies.backends import ProcessBackend\n"
+        "def slow(x):\n"
+        "    time.sleep(x)\n"
+        "    return os.getpid()\n"
+        "backend = ProcessBackend(2)\n"
+        "print(sorted(set(backend.run(slow, [0.5, 0.5, 0.5, 0.5]))), flush=True)\n"  # the workers' pids
+        "list(backend.run(slow, [60.0, 60.0]))\n")
+    parent = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE, text=True,
+                              env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)})
+    first = parent.stdout.readline()
+    assert first.startswith("[")
+    time.sleep(1.0)
+    children = [int(pid) for pid in subprocess.run(["pgrep", "-P", str(parent.pid)], capture_output=True,
+                                                   text=True).stdout.split()]
+    parent.send_signal(signal.SIGKILL)
+    parent.wait()
+    assert children
+    deadline = time.monotonic() + 10.0
+    while time.monotonic() < deadline and any(_alive(pid) for pid in children):
+        time.sleep(0.2)
+    alive = [pid for pid in children if _alive(pid)]
+    for pid in alive:  # clean up before failing
+        os.kill(pid, signal.SIGKILL)
+    assert not alive
+
+
+def _alive(pid: int) -> bool:
+    import os
+
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    try:  # a zombie (exited, not yet reaped by init) counts as gone
+        with open(f"/proc/{pid}/stat") as handle:
+            return handle.read().split(")")[-1].split()[0] != "Z"
+    except OSError:
+        return False

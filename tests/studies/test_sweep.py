@@ -238,3 +238,11 @@ def test_a_tqdm_bar_on_a_terminal_only(capsys, monkeypatch):
     assert "sweep: 100%" in err and "2/2" in err and "point/s" in err   # the rate (and the time left) shown
     run_sweep(model_i(), grid, end_time=0.2, workers=1, progress=False)
     assert capsys.readouterr().err == ""
+
+
+def test_bad_workers_are_refused_even_with_nothing_left_to_run(tmp_path):
+    path = tmp_path / "s.csv"
+    run_sweep(model_i(), {"contact.gap": [0.0]}, end_time=0.2, workers=1, progress=False, out=path)
+    with pytest.raises(SceneError) as info:
+        run_sweep(model_i(), {"contact.gap": [0.0]}, end_time=0.2, workers=0, progress=False, out=path)
+    assert info.value.key == "workers"
