@@ -420,7 +420,8 @@ def optimise(scene: Scene, bounds: Mapping[str, tuple[float, float]], minimise: 
         parameters={k: float(v) for k, v in zip(keys, solution.x)}, metrics=metric_values,
         constraint_values=constraint_values, feasible=bool(best["feasible"]), history=history,
         convergence=pd.DataFrame(convergence_rows),
-        settings={"seed": seed, "popsize": popsize, "population": popsize * len(keys), "maxiter": maxiter,
+        settings={"seed": seed, "popsize": popsize, "population": max(5, popsize * len(keys)),  # scipy's rule
+                  "maxiter": maxiter,
                   "tol": tol, "init": init, "strategy": "best1bin", "end_time": end_time,
                   "accuracy": accuracy if isinstance(accuracy, str) else repr(accuracy),
                   "stop_when_final": ",".join(swf), "backend": backend.name, "workers": backend.workers},

@@ -20,7 +20,7 @@ def test_writes_results(tmp_path, capsys):
     assert code == 0, captured.err
     data = json.loads(captured.out)
     assert data["feasible"] and data["constraints"][0]["satisfied"]
-    assert data["settings"]["seed"] == 1 and data["settings"]["population"] == 3
+    assert data["settings"]["seed"] == 1 and data["settings"]["population"] == 5  # scipy's smallest
     assert sorted(p.name for p in out.iterdir()) == ["convergence.csv", "history.csv", "optimise.png", "optimum.json"]
     history = pd.read_csv(out / "history.csv")
     assert len(history) == data["evaluations"] and "contact.gap" in history.columns
