@@ -27,6 +27,8 @@ def test_writes_png(table_file, tmp_path, capsys, extra):
     assert main(["plot-sweep", str(table_file), "--out", str(out), *extra]) == 0
     captured = capsys.readouterr()
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    from matplotlib.image import imread
+    assert imread(out).shape[0] > 300  # decodes
     assert "skipped 1 failed row(s)" in captured.err
     assert f"wrote {out}" in captured.out
 

@@ -32,8 +32,17 @@ def _table(gaps=GAPS, masses=MASSES, failed: int = 0) -> pd.DataFrame:
 
 
 def _png_ok(fig) -> None:
+    """The figure renders to a PNG that decodes to the figure's size in pixels, not blank."""
+    import io
+
+    from matplotlib.image import imread
+
     data = figure_png(fig)
-    assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 5000
+    assert data[:8] == b"\x89PNG\r\n\x1a\n"
+    pixels = imread(io.BytesIO(data), format="png")
+    width, height = fig.get_size_inches() * fig.dpi
+    assert pixels.shape[:2] == (round(height), round(width))
+    assert pixels[..., :3].std() > 0.05
 
 
 def test_columns_are_told_apart():
