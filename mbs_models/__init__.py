@@ -16,8 +16,8 @@ from __future__ import annotations
 import importlib
 
 from .errors import RecoilError, SceneError, SimulationError
-from .scene import (TABLE_CLASSES, Conventions, Scene, apply_overrides, load_scene, model_i, model_ii, paper_model, scene_from_dict,
-                    parse_spec, scene_to_dict, scene_to_toml, simplified_model)
+from .scene import (TABLE_CLASSES, Conventions, Scene, apply_overrides, load_scene, model_i, model_ii, paper_model,
+                    parse_spec, scene_from_dict, scene_to_dict, scene_to_toml, simplified_model)
 
 globals().update(TABLE_CLASSES)  # Barrel, RecoilSpring, Absorber, Contact, ...: every element's table
 
@@ -37,6 +37,7 @@ _LAZY = {
     "Mechanism": ".engine.mechanism",
     "FINAL_METRICS": ".engine.final_metrics",   # names accepted by simulate(..., stop_when_final=...)
     "EnergyBounds": ".engine.final_metrics",
+    "contacts_out_of_reach": ".engine.reach",  # gaps and stops beyond the barrel's free-recoil travel
     "add_contact": ".elements.contact_laws",
     "add_recoil_damper": ".elements.recoil_damper",
     "add_recoil_brake": ".elements.recoil_brake",

@@ -97,6 +97,21 @@ def test_the_sweep_example_runs_and_gives_the_table(capsys):
     assert "peak_support_force" in capsys.readouterr().out
 
 
+def test_the_early_stop_example_prints_what_its_comment_says(capsys):
+    """The "From Python" block's early stop: the commented end time (s), stop reason and maximum (m)."""
+    block = _python_block_after("### From Python")
+    lines = block.splitlines()
+    i = next(n for n, line in enumerate(lines) if "stop_when_final=" in line and line.startswith("result ="))
+    call, printed = lines[i], lines[i + 1]
+    match = re.search(r"# ~(\S+) s, (\w+), (\S+) m$", printed)
+    assert match, printed
+    exec(compile(f"from mbs_models import model_ii, simulate\n{call}\n{printed}", "README", "exec"), {})
+    end_time, reason, x_max = capsys.readouterr().out.split()
+    assert float(end_time) == pytest.approx(float(match.group(1)), abs=0.006)
+    assert reason == match.group(2)
+    assert f"{float(x_max):.4f}" == match.group(3)
+
+
 _OPTIMISED_ROW = re.compile(r"^\| (--|model \(i\)|model \(ii\)) \| "
                             r"(simplified model|Table 2|gap alone, [AB]|[AB]: [^|]+) \| "
                             r"(--|\d+) \| (--|\d+\.?\d*) \| (\d+\.\d\d) \| (\d+\.\d{3}) \|$")

@@ -53,7 +53,8 @@ def add_sweep_parser(sub) -> None:
     sweep.add_argument("--out", required=True, metavar="FILE",
                        help="the table: .csv, or .parquet (needs pyarrow); an existing file of the same sweep "
                             "is resumed")
-    sweep.add_argument("--workers", type=int, default=None, help="local worker processes (default: all CPUs)")
+    sweep.add_argument("--workers", type=int, default=None, metavar="N",
+                       help="local worker processes (default: all CPUs)")
     sweep.add_argument("--scheduler", default=None, metavar="ADDRESS",
                        help="run on a Dask cluster: the scheduler's tcp://HOST:PORT (needs the cluster extra)")
     sweep.add_argument("--accuracy", default="standard", choices=("draft", "standard", "reference"))

@@ -198,16 +198,7 @@ def run_sweep(scene: Scene, params, *, end_time: float = 10.0, accuracy: str | S
     labels = grid.labels()
     points = grid.points()
     file = SweepFile(out, params_columns, metrics) if out is not None else None
-    done: dict[tuple, dict] = {}
-    if file is not None:
-        wanted = set(labels)
-        existing = file.read()
-        for row in existing.astype(object).where(existing.notna(), None).to_dict("records"):
-            label = tuple(row[key] for key in params_columns)
-            if label not in wanted:
-                raise SceneError("out", f"{file.path} holds points that are not in this sweep (e.g. "
-                                        f"{dict(zip(params_columns, label))}): choose another file, or delete it")
-            done.setdefault(label, row)
+    done = _rows_in_file(file, labels) if file is not None else {}
     pending = [(i, point) for i, (point, label) in enumerate(zip(points, labels)) if label not in done]
     backend = _backends.make_backend(workers, scheduler) if pending else _backends.SerialBackend()
     with backend:
@@ -237,6 +228,21 @@ def run_sweep(scene: Scene, params, *, end_time: float = 10.0, accuracy: str | S
                             "failed": int((table["status"] != "ok").sum()),
                             "out": None if file is None else str(file.path)}
     return table
+
+
+def _rows_in_file(file, labels: list[tuple]) -> dict[tuple, dict]:
+    """The rows a previous run of this sweep left in ``file``, by their parameter values; SceneError if it
+    holds a point that is not in this sweep (another sweep's file)."""
+    wanted = set(labels)
+    existing = file.read()
+    done: dict[tuple, dict] = {}
+    for row in existing.astype(object).where(existing.notna(), None).to_dict("records"):
+        label = tuple(row[key] for key in file.params)
+        if label not in wanted:
+            raise SceneError("out", f"{file.path} holds points that are not in this sweep (e.g. "
+                                    f"{dict(zip(file.params, label))}): choose another file, or delete it")
+        done.setdefault(label, row)
+    return done
 
 
 class _Bar:
