@@ -48,6 +48,7 @@ _LAZY = {
     "add_recuperator": ".elements.recuperator",
     "add_body": ".engine.assembly",
     "run_sweep": ".studies.sweep",           # a grid over dotted scene keys -> a pandas table (recoil sweep)
+    "optimise": ".studies.optimise",         # the best design within bounds (recoil optimise)
 }
 
 __all__ = [

@@ -227,6 +227,11 @@ def build_parser() -> argparse.ArgumentParser:
     design.add_argument("--json", action="store_true", help="print the comparison as JSON")
     design.set_defaults(handler=_cmd_design_brake)
     add_sweep_parser(sub)
+
+    from .plot_sweep import add_parser as add_plot_sweep
+    from .optimise import add_parser as add_optimise
+    add_plot_sweep(sub)
+    add_optimise(sub)
     return parser
 
 
