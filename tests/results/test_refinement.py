@@ -9,7 +9,8 @@ from mbs_models import load_scene, model_ii, simulate
 from mbs_models.engine import simulation
 from mbs_models.results.refinement import refine
 from mbs_models.results.samples import Interpolant
-from mbs_models.scenes import scene_path
+from mbs_models.engine.mechanism import Mechanism
+from mbs_models.scenes import list_scenes, scene_path
 
 
 def solved(scene, end_time):
@@ -67,7 +68,11 @@ def test_an_episode_lifted_over_the_threshold_by_its_refined_peak_gets_refined_b
     assert late.end[e] == one_bracket_crossing(lambda x: ~positive(x), t[i1], t[i1 + 1])
 
 
-@pytest.mark.parametrize("name", ["end_stops", "two_absorbers"])
+#: The shipped scenes with several contacts (absorbers or end stops).
+SEVERAL_CONTACTS = [name for name in list_scenes() if len(Mechanism(load_scene(scene_path(name))).contacts) > 1]
+
+
+@pytest.mark.parametrize("name", SEVERAL_CONTACTS)
 def test_contacts_together_equal_contacts_alone(name):
     """Several contacts and the support peak share the rounds; each gets what it gets alone."""
     mechanism, s = solved(load_scene(scene_path(name)), 3.0)
