@@ -6,6 +6,10 @@ Public API (one entry point per task)::
     result = simulate(model_ii(absorber_mass=1000.0, gap=0.04), end_time=10.0)
     print(result.max_barrel_displacement)
 
+    from mbs_models import apply_overrides, run_sweep
+    lighter = apply_overrides(model_ii(), {"absorber.mass": 500.0, "contact.gap": 0.02})   # dotted keys
+    table = run_sweep(model_ii(), {"absorber.mass": [100, 1000], "contact.gap": "0:0.12:13"}, out="gaps.csv")
+
 Scenes (:mod:`.scene`) and their elements' tables (:mod:`.elements`) are imported eagerly and need no
 Exudyn; the engine (:mod:`.engine`), results (:mod:`.results`) and studies are imported on first use,
 so that scenes can be read, checked and written without ever loading Exudyn.
@@ -16,8 +20,8 @@ from __future__ import annotations
 import importlib
 
 from .errors import RecoilError, SceneError, SimulationError
-from .scene import (TABLE_CLASSES, Conventions, Scene, load_scene, model_i, model_ii, paper_model, scene_from_dict,
-                    scene_to_dict, scene_to_toml, simplified_model)
+from .scene import (TABLE_CLASSES, Conventions, Scene, apply_overrides, load_scene, model_i, model_ii, paper_model,
+                    parse_spec, scene_from_dict, scene_to_dict, scene_to_toml, simplified_model)
 
 globals().update(TABLE_CLASSES)  # Barrel, RecoilSpring, Absorber, Contact, ...: every element's table
 
@@ -37,17 +41,20 @@ _LAZY = {
     "Mechanism": ".engine.mechanism",
     "FINAL_METRICS": ".engine.final_metrics",   # names accepted by simulate(..., stop_when_final=...)
     "EnergyBounds": ".engine.final_metrics",
+    "contacts_out_of_reach": ".engine.reach",  # gaps and stops beyond the barrel's free-recoil travel
     "add_contact": ".elements.contact_laws",
     "add_recoil_damper": ".elements.recoil_damper",
     "add_recoil_brake": ".elements.recoil_brake",
     "add_recuperator": ".elements.recuperator",
     "add_body": ".engine.assembly",
+    "run_sweep": ".studies.sweep",           # a grid over dotted scene keys -> a pandas table (recoil sweep)
+    "optimise": ".studies.optimise",         # the best design within bounds (recoil optimise)
 }
 
 __all__ = [
     *TABLE_CLASSES, "Conventions", "Scene",
     "RecoilError", "SceneError", "SimulationError",
-    "load_scene", "scene_from_dict", "scene_to_dict", "scene_to_toml",
+    "load_scene", "scene_from_dict", "scene_to_dict", "scene_to_toml", "apply_overrides", "parse_spec",
     "model_i", "model_ii", "paper_model", "simplified_model",
     *_LAZY,
 ]

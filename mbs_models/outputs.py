@@ -1,6 +1,8 @@
 """Writing output files safely: check the directory first, write to a temporary name, then rename.
 
-A report that fails half-way never leaves a half-written file under its final name.
+A report that fails half-way never leaves a half-written file under its final name.  The files get the
+permissions any tool gives a new file: ``0666`` minus the process's umask (``0644`` under umask 022),
+not the ``0600`` of a temporary file.
 """
 
 from __future__ import annotations
@@ -28,8 +30,43 @@ def prepare_output_dir(path: str | Path, key: str = "--out") -> Path:
     return path
 
 
+def current_umask() -> int:
+    """The process's umask, read without changing it where Linux reports it (``/proc/self/status``);
+    elsewhere set and restored at once."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as status:
+            for line in status:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def check_output_file(path: str | Path, key: str) -> Path:
+    """Check that a file can be written at ``path``: its directory exists and is writable, and ``path``
+    is not a directory.  SceneError naming ``key`` otherwise; nothing is created (a missing directory is
+    refused, not made: a typo must not leave a directory tree behind)."""
+    path = Path(path)
+    directory = path.parent
+    if path.is_dir():
+        raise SceneError(key, f"{path} is a directory, not a file")
+    if not directory.exists():
+        raise SceneError(key, f"directory {directory} does not exist")
+    if not directory.is_dir():
+        raise SceneError(key, f"{directory} is not a directory")
+    if not os.access(directory, os.W_OK | os.X_OK):
+        raise SceneError(key, f"directory {directory} is not writable")
+    return path
+
+
 def atomic_write_bytes(path: str | Path, data: bytes) -> Path:
-    """Write ``data`` to ``path`` via a temporary file in the same directory and an atomic rename."""
+    """Write ``data`` to ``path`` via a temporary file in the same directory and an atomic rename.
+
+    The file's mode is ``0666 & ~umask``, as ``open(path, "wb")`` would give it.
+    """
     path = Path(path)
     directory = path.parent if str(path.parent) else Path(".")
     try:
@@ -38,6 +75,7 @@ def atomic_write_bytes(path: str | Path, data: bytes) -> Path:
         raise SceneError(str(path), f"cannot write: {exc.strerror or exc}") from None
     try:
         with os.fdopen(handle, "wb") as stream:
+            os.fchmod(stream.fileno(), 0o666 & ~current_umask())
             stream.write(data)
         os.replace(temporary, path)
     except BaseException:

@@ -1,4 +1,5 @@
-# Sourced by the entry scripts: create .venv (once) and install the project with its test extra.
+# Sourced by the entry scripts: create .venv (once) and install the project with its test extra, the
+# cluster extra (Dask: the sweep tests run a local cluster) and the parquet extra (pyarrow).
 # Needs only Python >= 3.11 with venv and pip; the packages come from PyPI.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -12,7 +13,7 @@ fi
 STAMP=.venv/.recoil-installed
 if [ ! -f "$STAMP" ] || [ pyproject.toml -nt "$STAMP" ]; then
     echo "[setup] installing the project and its dependencies into .venv" >&2
-    .venv/bin/python -m pip install --quiet --disable-pip-version-check -e ".[test]"
+    .venv/bin/python -m pip install --quiet --disable-pip-version-check -e ".[test,cluster,parquet]"
     touch "$STAMP"
 fi
 VENV_PYTHON="$ROOT/.venv/bin/python"

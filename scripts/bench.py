@@ -419,6 +419,8 @@ def main(argv=None) -> int:
     for name, value in stages.items():
         print(f"   {name:40s} {100 * value / run_total:5.1f} %  [{ms(value)}]")
     print(f"   (stage sum / simulate() wall time: {run_total / t_standard:.2f})")
+    print(f"   post-processing (analyse) / solve: {stages['metrics (analyse)'] / stages['solve (Exudyn SolveDynamic)']:.3f}"
+          " (issue #11's target: <= 0.15)")
     if memory is not None:
         print(f"\n4. memory over {args.memory_runs} consecutive runs ({args.memory_end_time:g} s each, "
               f"standard, symbolic user functions)")

@@ -2,7 +2,7 @@
 """The README's figures of richer mechanisms: ``python scripts/readme_figures.py`` writes ``docs/figures/*.png``.
 
 One figure per shipped version-2 example scene that is not a contact-law variant (``NAME.png``):
-positions, contact forces, the force on the mount and velocities over the first 3 s.
+positions, contact forces, the force on the mount and velocities over the first 3 s, and a zoom on the first impact.
 """
 
 from __future__ import annotations

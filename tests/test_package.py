@@ -13,7 +13,7 @@ def _run(code: str) -> subprocess.CompletedProcess:
 
 def test_simulate_stays_a_function_after_engine_modules_are_imported():
     code = ("import mbs_models.studies.sweep as s, mbs_models.engine.simulation, mbs_models; "
-            "s.run_sweep([mbs_models.simplified_model()], end_time=0.1, workers=1); "
+            "s.run_scenes([mbs_models.simplified_model()], end_time=0.1, workers=1); "
             "import types; assert isinstance(mbs_models.simulate, types.FunctionType), mbs_models.simulate; "
             "from mbs_models import simulate; assert callable(simulate)")
     proc = _run(code)

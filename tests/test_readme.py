@@ -85,3 +85,66 @@ def test_the_files_that_know_about_an_effect_are_the_ones_listed():
     knowing = {path for path in tracked if path.endswith((".py", ".toml")) and path != "tests/test_readme.py"
                and names.search((root / path).read_text(errors="replace"))}  # (this checker names them, of course)
     assert knowing == listed
+
+
+def test_the_sweep_example_runs_and_gives_the_table(capsys):
+    """The README's run_sweep example: a 2 x 2 grid, every point ok."""
+    namespace: dict = {}
+    exec(compile(_python_block_after("### `recoil sweep`"), "README", "exec"), namespace)
+    table = namespace["table"]
+    assert len(table) == 4 and (table["status"] == "ok").all()
+    assert table["contact.gap"].tolist() == [0.0, 0.04, 0.0, 0.04]
+    assert "peak_support_force" in capsys.readouterr().out
+
+
+def test_the_early_stop_example_prints_what_its_comment_says(capsys):
+    """The "From Python" block's early stop: the commented end time (s), stop reason and maximum (m)."""
+    block = _python_block_after("### From Python")
+    lines = block.splitlines()
+    i = next(n for n, line in enumerate(lines) if "stop_when_final=" in line and line.startswith("result ="))
+    call, printed = lines[i], lines[i + 1]
+    match = re.search(r"# ~(\S+) s, (\w+), (\S+) m$", printed)
+    assert match, printed
+    exec(compile(f"from mbs_models import model_ii, simulate\n{call}\n{printed}", "README", "exec"), {})
+    end_time, reason, x_max = capsys.readouterr().out.split()
+    assert float(end_time) == pytest.approx(float(match.group(1)), abs=0.006)
+    assert reason == match.group(2)
+    assert f"{float(x_max):.4f}" == match.group(3)
+
+
+_OPTIMISED_ROW = re.compile(r"^\| (--|model \(i\)|model \(ii\)) \| "
+                            r"(simplified model|Table 2|gap alone, [AB]|[AB]: [^|]+) \| "
+                            r"(--|\d+) \| (--|\d+\.?\d*) \| (\d+\.\d\d) \| (\d+\.\d{3}) \|$")
+
+
+def test_readme_optimised_absorbers_are_the_scripts_and_the_engines():
+    """The optimised-absorber table: the numbers scripts/optimise_absorbers.py wrote, and the engine's at
+    those designs (full 10 s runs)."""
+    import json
+
+    data = json.loads((README.parent / "docs" / "optimise_absorbers.json").read_text())
+    rows = [m.groups() for line in README.read_text().splitlines() if (m := _OPTIMISED_ROW.match(line))]
+    assert len(rows) == 14
+    for mount, design, mass, gap, length, force in rows:
+        factory = model_i if mount == "model (i)" else model_ii
+        if design == "simplified model":
+            values, scene = data["simplified"], simplified_model()
+        elif design == "Table 2":
+            assert gap == "0"
+            values, scene = data["mounts"][mount]["paper_designs"][mass], factory(float(mass), 0.0)
+        elif design.startswith("gap alone"):
+            best = data["mounts"][mount]["gap_only"][mass][design[-1]]
+            assert gap == f"{best['gap'] * 1e3:.1f}"
+            values, scene = best["full_run"], factory(float(mass), best["gap"])
+        else:
+            best = data["mounts"][mount][design[0]]
+            parameters = best["parameters"]
+            assert best["feasible"] and (mass, gap) == (f"{parameters['absorber.mass']:.0f}",
+                                                        f"{parameters['contact.gap'] * 1e3:.1f}")
+            values = best["full_run"]["standard"]
+            scene = factory(parameters["absorber.mass"], parameters["contact.gap"])
+        assert (length, force) == (f"{values['max_barrel_displacement'] * 1e3:.2f}",
+                                   f"{values['peak_support_force'] / 1e3:.3f}"), (mount, design, mass)
+        result = simulate(scene, 10.0)
+        assert (length, force) == (f"{result.max_barrel_displacement * 1e3:.2f}",
+                                   f"{result.peak_support_force / 1e3:.3f}"), (mount, design, mass)

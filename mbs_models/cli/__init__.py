@@ -8,15 +8,24 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 import time
 from pathlib import Path
 from typing import Sequence
 
+from .. import __version__
 from ..errors import SceneError, SimulationError
 from ..scene import load_scene
+from . import run
+from .sweep import add_set_argument, add_sweep_parser, apply_sets
 
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
+#: What the accuracy presets mean (mbs_models.engine.accuracy.ACCURACY_PRESETS: the worst relative error of
+#: the max barrel displacement stated there, and the time relative to draft).
+ACCURACY_HELP = ("solver accuracy (default: standard): draft = fast, for plots and exploration (max barrel "
+                 "displacement within 1e-4); standard = results (1e-7, ~1.4x draft's time); reference = "
+                 "validation (1e-9, ~1.8x)")
 _ARGUMENT_NAMES = {"end_time": "--end-time", "accuracy": "--accuracy", "impact_threshold": "--impact-threshold",
                    "user_functions": "--user-functions"}
 
@@ -40,27 +49,6 @@ def _resolve_scene(path: str):
         if path in list_scenes():
             candidate = scene_path(path)
     return load_scene(candidate)
-
-
-def _cmd_run(args) -> int:
-    from ..engine.simulation import simulate
-
-    scene = _resolve_scene(args.scene)
-    if args.plot:
-        from ..outputs import prepare_output_dir
-        prepare_output_dir(Path(args.plot).parent or Path("."), key="--plot")
-    result = simulate(scene, args.end_time, args.accuracy, user_functions=args.user_functions,
-                      impact_threshold=args.impact_threshold)
-    if args.plot:
-        from ..results.plotting import plot_result, save_figure
-        save_figure(plot_result(result), args.plot)
-    if args.json:
-        print(json.dumps(result.metrics(), indent=2, allow_nan=False))
-    else:
-        print(result.summary())
-        if args.plot:
-            print(f"  plot                     {args.plot}")
-    return EXIT_OK
 
 
 def _cmd_paper(args) -> int:
@@ -90,7 +78,8 @@ def _cmd_paper(args) -> int:
 def _cmd_validate(args) -> int:
     from validation.studies.compare import compare
 
-    scene = _resolve_scene(args.scene)
+    scene = apply_sets(_resolve_scene(args.scene), args.set)
+    run.warn_out_of_reach(scene)
     comparison = compare(scene, args.end_time, args.accuracy, impact_threshold=args.impact_threshold)
     if args.json:
         print(json.dumps(comparison.to_dict(), indent=2, allow_nan=False))
@@ -181,27 +170,21 @@ def _cmd_design_brake(args) -> int:
 
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="recoil", description="Recoil mechanisms with impact absorbers (Exudyn).")
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
-    run = sub.add_parser("run", help="simulate one scene and print its metrics")
-    run.add_argument("scene", help="scene TOML file, or the name of a shipped scene (see the README: model_i, model_ii, two_absorbers, ...)")
-    run.add_argument("--end-time", type=float, default=10.0, help="simulated time in s (default 10)")
-    run.add_argument("--accuracy", default="standard", choices=("draft", "standard", "reference"))
-    run.add_argument("--json", action="store_true", help="print the metrics as one JSON object")
-    run.add_argument("--plot", metavar="FILE", help="write the time histories as PNG")
-    run.add_argument("--user-functions", choices=("symbolic", "python"), default=None,
-                     help="user-function backend (default symbolic; python is slower, for debugging)")
-    run.add_argument("--impact-threshold", type=float, default=1000.0,
-                     help="peak force (N) above which a contact episode counts as an impact (default 1000)")
-    run.set_defaults(handler=_cmd_run)
+    run.add_parser(sub, ACCURACY_HELP)
 
     validate = sub.add_parser("validate", help="engine vs the independent scipy reference for one scene "
                                                "(exit code 1 if a tolerance is exceeded)")
     validate.add_argument("scene", help="scene TOML file, or the name of a shipped scene (see the README: model_i, model_ii, two_absorbers, ...)")
     validate.add_argument("--end-time", type=float, default=10.0, help="simulated time in s (default 10)")
-    validate.add_argument("--accuracy", default="standard", choices=("draft", "standard", "reference"))
-    validate.add_argument("--impact-threshold", type=float, default=1000.0, help="impact threshold in N")
+    validate.add_argument("--accuracy", default="standard", choices=("draft", "standard", "reference"),
+                          help=ACCURACY_HELP)
+    validate.add_argument("--impact-threshold", type=float, default=1000.0,
+                          help="peak force (N) above which a contact episode counts as an impact (default 1000)")
     validate.add_argument("--json", action="store_true", help="print the comparison as JSON")
+    add_set_argument(validate)
     validate.set_defaults(handler=_cmd_validate)
 
     paper = sub.add_parser("paper", help="reproduce the paper: Table 2 and the figures")
@@ -229,7 +212,8 @@ def build_parser() -> argparse.ArgumentParser:
     laws = sub.add_parser("contact-laws", help="the contact-law family on a free impact: restitution achieved vs "
                                                "requested (closed form and engine) and force-penetration loops")
     laws.add_argument("--out", default="contact-laws", help="output directory (default ./contact-laws)")
-    laws.add_argument("--accuracy", default="standard", choices=("draft", "standard", "reference"))
+    laws.add_argument("--accuracy", default="standard", choices=("draft", "standard", "reference"),
+                      help=ACCURACY_HELP)
     laws.add_argument("--json", action="store_true", help="print the study as JSON")
     laws.set_defaults(handler=_cmd_contact_laws)
 
@@ -238,9 +222,16 @@ def build_parser() -> argparse.ArgumentParser:
     design.add_argument("scene", help="scene TOML file or shipped scene (a barrel without absorbers, e.g. simplified)")
     design.add_argument("--recoil-length", type=float, required=True, metavar="L", help="recoil length in m")
     design.add_argument("--out", default="design-brake", help="output directory (default ./design-brake)")
-    design.add_argument("--accuracy", default="standard", choices=("draft", "standard", "reference"))
+    design.add_argument("--accuracy", default="standard", choices=("draft", "standard", "reference"),
+                        help=ACCURACY_HELP)
     design.add_argument("--json", action="store_true", help="print the comparison as JSON")
     design.set_defaults(handler=_cmd_design_brake)
+    add_sweep_parser(sub)
+
+    from .plot_sweep import add_parser as add_plot_sweep
+    from .optimise import add_parser as add_optimise
+    add_plot_sweep(sub)
+    add_optimise(sub)
     return parser
 
 
@@ -257,6 +248,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     except SimulationError as exc:
         print(f"recoil: simulation failed: {exc}", file=sys.stderr)
         return EXIT_FAILED
+    except BrokenPipeError:  # piped into a program that stopped reading (head): the run itself succeeded
+        try:  # Python's documented recipe: the interpreter's final flush goes to /dev/null, not a traceback
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        except (OSError, ValueError, AttributeError):
+            pass
+        return EXIT_OK
     except KeyboardInterrupt:
         print("recoil: interrupted", file=sys.stderr)
         return 130

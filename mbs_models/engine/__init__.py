@@ -6,7 +6,8 @@
 * :mod:`.accuracy` -- solver settings and the accuracy presets;
 * :mod:`.stability` -- contact time scales, unsafe steps refused, stepped-over contacts, energy balance;
 * :mod:`.guard` -- the step budget of adaptive solves;
-* :mod:`.final_metrics` -- the early stop once energy bounds prove the peak metrics final.
+* :mod:`.final_metrics` -- the early stop once energy bounds prove the peak metrics final;
+* :mod:`.reach` -- contacts that can never close (a gap beyond the barrel's free-recoil travel).
 
 This package imports Exudyn.
 """

@@ -484,6 +484,11 @@ class EnergyBounds:
             return self.well.upper(self.contacts[j], self._excess(energy))
         return math.sqrt(self._contact_coefficients[j] * self._excess(energy))
 
+    def contact_reach(self, j: int, energy: float) -> float:
+        """Bound (m) on contact ``j``'s relative coordinate d at every later time (the contact closes where
+        ``d > offset``): ``sqrt(2E g^T K^+ g)`` from the springs, a potential well's end, inf without a bound."""
+        return self._upper(j, energy)
+
     def contact_reachable(self, j: int, energy: float) -> bool:
         """Can contact ``j`` (index in :attr:`contacts`) close (p > 0) ever again?"""
         return self._upper(j, energy) > self.contacts[j].offset

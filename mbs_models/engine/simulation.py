@@ -407,6 +407,38 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
         energy-balance error stayed below the bounds' slack; otherwise the scene is re-solved to
         ``end_time`` (``stop_reason == "end_time_energy_check"``).  Empty (default): run to ``end_time``.
 
+    Returns
+    -------
+    Result (:class:`mbs_models.results.result.Result`), SI units throughout:
+
+    * time histories at the solver's output steps: ``time`` (s); ``positions``, ``velocities``,
+      ``accelerations`` per body name (``"barrel"`` and the absorbers; m, m/s, m/s^2); ``contacts`` per
+      contact name (:class:`~mbs_models.results.result.ContactOutput`: force history N, peak, impacts);
+      ``support_force`` (N, the force on the mount, positive in the recoil direction); energies per
+      body/connector (``kinetic_energy_histories``, ``stored_energy_histories``,
+      ``dissipated_energy_history``, ``work_histories``; J) and :meth:`~Result.energy_error`;
+    * metrics, refined between samples: ``max_barrel_displacement`` (m) and its time,
+      ``peak_support_force`` (N), ``peak_contact_force`` (N) and ``max_absorber_velocity`` (m/s) over all
+      absorbers, each with its time; ``impacts`` (contact episodes above ``impact_threshold``, in time
+      order); ``dissipated_energy`` (J per connector); :meth:`~Result.absorbers`, :meth:`~Result.stops`,
+      :meth:`~Result.energy` per element; ``max_at_end_of_window`` (the maximum is the window's last
+      instant, not a turning point);
+    * the run: ``end_time`` and ``requested_end_time`` (s), ``stop_reason``, ``final_metrics``,
+      ``settings``, ``steps``, ``wall_time`` (s); :meth:`~Result.metrics` (a JSON-ready dict, the keys of
+      ``recoil run --json``) and :meth:`~Result.summary` (text).
+
+    Metrics of effects the scene lacks are None (never 0 for "no absorber"); an absorber that is never
+    touched has ``peak_contact_force == 0.0`` with no time.
+
+    Example
+    -------
+    >>> from mbs_models import model_ii, simulate
+    >>> result = simulate(model_ii(absorber_mass=1000.0, gap=0.0), end_time=2.0)
+    >>> round(result.max_barrel_displacement, 4), round(result.time_of_max_barrel_displacement, 3)
+    (0.1508, 0.508)
+    >>> round(result.peak_contact_force / 1e3, 1), len(result.impacts)   # kN
+    (123.3, 4)
+
     Raises
     ------
     SceneError: an argument is invalid, or a fixed step is unsafe for the scene (the message names it

@@ -8,44 +8,25 @@ acceleration), which is fourth-order accurate in the step size.
 
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 
-def hermite(t0, t1, y0, y1, dy0, dy1, t):
-    """Evaluate the cubic Hermite interpolant on [t0, t1] at ``t`` (arrays broadcast)."""
-    h = t1 - t0
-    s = (t - t0) / h
-    s2, s3 = s * s, s * s * s
-    return ((2 * s3 - 3 * s2 + 1) * y0 + (s3 - 2 * s2 + s) * h * dy0
-            + (-2 * s3 + 3 * s2) * y1 + (s3 - s2) * h * dy1)
+from .hermite import HermiteTrajectory, hermite  # noqa: F401  (re-exported: the interpolant of the refinements)
+from .nested_grids import first_true, maxima_search, run, values_at
 
 
-class HermiteTrajectory:
-    """Piecewise-cubic Hermite interpolant of a sampled quantity ``y`` with derivative ``dy``."""
-
-    def __init__(self, time: np.ndarray, y: np.ndarray, dy: np.ndarray):
-        self.time = np.asarray(time, dtype=float)
-        self.y = np.asarray(y, dtype=float)
-        self.dy = np.asarray(dy, dtype=float)
-
-    def __call__(self, t):
-        t = np.asarray(t, dtype=float)
-        i = np.clip(np.searchsorted(self.time, t, side="right") - 1, 0, len(self.time) - 2)
-        return hermite(self.time[i], self.time[i + 1], self.y[i], self.y[i + 1], self.dy[i], self.dy[i + 1], t)
-
-    def on_intervals(self, fractions: np.ndarray) -> np.ndarray:
-        """Values at ``t_i + f h_i`` for every interval i and fraction f: shape (intervals, fractions)."""
-        t0, t1 = self.time[:-1, None], self.time[1:, None]
-        f = np.asarray(fractions, dtype=float)[None, :]
-        if np.all(t1 > t0):
-            return hermite(t0, t1, self.y[:-1, None], self.y[1:, None], self.dy[:-1, None], self.dy[1:, None],
-                           t0 + f * (t1 - t0))
-        # zero-length intervals (a jump at a segment boundary, e.g. a shot): the value before the jump
-        with np.errstate(invalid="ignore", divide="ignore"):
-            values = hermite(t0, t1, self.y[:-1, None], self.y[1:, None], self.dy[:-1, None], self.dy[1:, None],
-                             t0 + f * (t1 - t0))
-        return np.where(t1 > t0, values, self.y[:-1, None])
+def run_bounds(flags: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(first, last)`` index arrays (inclusive) of the maximal runs of True in a 1-D boolean array."""
+    active = np.asarray(flags, dtype=bool)
+    edges = np.diff(active.astype(np.int8))
+    first = np.flatnonzero(edges == 1) + 1
+    last = np.flatnonzero(edges == -1)
+    if len(active) and active[0]:
+        first = np.concatenate([[0], first])
+    if len(active) and active[-1]:
+        last = np.concatenate([last, [len(active) - 1]])
+    return first.astype(int), last.astype(int)
 
 
 def runs_of_true(flags: np.ndarray) -> list[tuple[int, int]]:
@@ -53,17 +34,24 @@ def runs_of_true(flags: np.ndarray) -> list[tuple[int, int]]:
 
     The contact episodes of a sampled force are ``runs_of_true(force > 0)``.
     """
-    active = np.asarray(flags, dtype=bool)
-    if not active.any():
-        return []
-    edges = np.diff(active.astype(np.int8))
-    starts = list(np.flatnonzero(edges == 1) + 1)
-    ends = list(np.flatnonzero(edges == -1))
-    if active[0]:
-        starts.insert(0, 0)
-    if active[-1]:
-        ends.append(len(active) - 1)
-    return [(int(i0), int(i1)) for i0, i1 in zip(starts, ends)]
+    first, last = run_bounds(flags)
+    return list(zip(first.tolist(), last.tolist()))
+
+
+def run_argmax(values: np.ndarray, first: np.ndarray, last: np.ndarray) -> np.ndarray:
+    """Index of the (first) largest of ``values[first[r]:last[r] + 1]`` for every run r (runs disjoint,
+    increasing, values not NaN): ``np.argmax`` per run, in one pass over the samples of all runs."""
+    if not len(first):
+        return np.zeros(0, dtype=int)
+    lengths = last - first + 1
+    offsets = np.concatenate([[0], np.cumsum(lengths)[:-1]])
+    index = np.repeat(first - offsets, lengths) + np.arange(int(lengths.sum()))  # the samples of every run
+    run = np.repeat(np.arange(len(first)), lengths)
+    inside = values[index]
+    largest = np.maximum.reduceat(inside, offsets)
+    at_largest = np.flatnonzero(inside == largest[run])
+    _, first_of_run = np.unique(run[at_largest], return_index=True)
+    return index[at_largest[first_of_run]]
 
 
 def refine_maximum(time: np.ndarray, y: np.ndarray, dy: np.ndarray) -> tuple[float, float]:
@@ -103,35 +91,67 @@ def refine_maximum(time: np.ndarray, y: np.ndarray, dy: np.ndarray) -> tuple[flo
     return best_value, best_time
 
 
+def maxima_near_samples(time: np.ndarray, ks: np.ndarray, points: int = 65, levels: int = 4):
+    """The searches for the maxima of a function near each sample ``ks[i]``, and how to read them.
+
+    Returns ``(searches, assemble)``: generators for :func:`~mbs_models.results.nested_grids.run` (a
+    :func:`~mbs_models.results.nested_grids.maxima_search` over [t_{k-1}, t_{k+1}] for every k whose
+    bracket is not empty; the value at ``t_k`` itself where it is, equal times at a jump), and
+    ``assemble(results)`` -> ``(values, times)`` arrays in the order of ``ks``.
+    """
+    time = np.asarray(time, dtype=float)
+    ks = np.asarray(ks, dtype=int)
+    lo = time[np.maximum(ks - 1, 0)]
+    hi = time[np.minimum(ks + 1, len(time) - 1)]
+    open_ = hi > lo
+    searches, kinds = [], []
+    if open_.any():
+        searches.append(maxima_search(lo[open_], hi[open_], points, levels))
+        kinds.append("open")
+    if not open_.all():
+        searches.append(values_at(time[ks[~open_]]))
+        kinds.append("closed")
+
+    def assemble(results) -> tuple[np.ndarray, np.ndarray]:
+        values = np.empty(len(ks))
+        times = np.empty(len(ks))
+        for kind, result in zip(kinds, results):
+            if kind == "open":
+                values[open_], times[open_] = result
+            else:
+                times[~open_] = time[ks[~open_]]
+                values[~open_] = np.asarray(result, dtype=float)
+        return values, times
+
+    return searches, assemble
+
+
+def refine_function_maxima(f: Callable[[np.ndarray], np.ndarray], time: np.ndarray, ks: np.ndarray,
+                           points: int = 65, levels: int = 4) -> tuple[np.ndarray, np.ndarray]:
+    """Maxima ``(values, times)`` of a continuous ``f(t)`` near each sample ``ks[i]``, all at once.
+
+    ``f`` maps a 1-D array of times to an array of that shape.  Each is searched over
+    [t_{k-1}, t_{k+1}] by :func:`~mbs_models.results.nested_grids.maxima_search` (nested uniform
+    grids, then a parabola through the best three points): ``levels + 1`` calls of ``f`` in all,
+    resolution ~ h / points**levels.  Where the bracket is empty (equal times at a jump) the value is
+    ``f(t_k)`` at ``t_k``.
+    """
+    searches, assemble = maxima_near_samples(time, ks, points, levels)
+    return assemble(run(lambda times, parts: [f(times[part]) for _, part in parts], searches))
+
+
 def refine_function_maximum(f: Callable[[np.ndarray], np.ndarray], time: np.ndarray, k: int,
                             points: int = 65, levels: int = 4) -> tuple[float, float]:
     """Maximum ``(value, time)`` of a continuous function ``f(t)`` near sample ``k``.
 
-    ``f`` takes an array of times.  It is searched over [t_{k-1}, t_{k+1}] on nested uniform grids
+    ``f`` takes a 1-D array of times.  It is searched over [t_{k-1}, t_{k+1}] on nested uniform grids
     (each level zooms on the best point's neighbours), then a parabola through the best three
     points gives the final estimate: a few vectorised calls, resolution ~ h / points**levels.
+    (:func:`refine_function_maxima` with one sample.)
     """
-    lo = time[max(k - 1, 0)]
-    hi = time[min(k + 1, len(time) - 1)]
-    if hi <= lo:
-        return float(f(np.array([time[k]]))[0]), float(time[k])
-    for _ in range(levels):
-        grid = np.linspace(lo, hi, points)
-        values = np.asarray(f(grid), dtype=float)
-        j = int(np.argmax(values))
-        lo, hi = grid[max(j - 1, 0)], grid[min(j + 1, points - 1)]
-    best_value, best_time = float(values[j]), float(grid[j])
-    if 0 < j < points - 1:
-        y0, y1, y2 = values[j - 1], values[j], values[j + 1]
-        curvature = y0 - 2 * y1 + y2
-        if curvature < 0:
-            shift = 0.5 * (y0 - y2) / curvature
-            step = grid[1] - grid[0]
-            t_vertex = grid[j] + shift * step
-            value = float(f(np.array([t_vertex]))[0])
-            if value > best_value:
-                best_value, best_time = value, float(t_vertex)
-    return best_value, best_time
+    values, times = refine_function_maxima(lambda t: np.reshape(f(np.ravel(t)), np.shape(t)), time, [k],
+                                           points, levels)
+    return float(values[0]), float(times[0])
 
 
 def refine_crossing(indicator: Callable[[np.ndarray], np.ndarray], t_false: float, t_true: float,
@@ -141,12 +161,8 @@ def refine_crossing(indicator: Callable[[np.ndarray], np.ndarray], t_false: floa
     Nested uniform grids: each level keeps the bracket around the first True point, so the
     resolution is (t_true - t_false) / (points - 1)**levels.  If the indicator is never True on a
     grid (it flips back and forth faster than the grid), ``t_true`` is returned.
+    (:func:`~mbs_models.results.nested_grids.first_true` with one bracket.)
     """
-    a, b = t_false, t_true
-    for _ in range(levels):
-        grid = np.linspace(a, b, points)
-        flags = np.asarray(indicator(grid), dtype=bool)
-        flags[-1] = True
-        j = int(np.argmax(flags[1:])) + 1  # first True after the left end
-        a, b = grid[j - 1], grid[j]
-    return float(0.5 * (a + b))
+    found = first_true(lambda t: np.reshape(indicator(np.ravel(t)), np.shape(t)), np.array([t_false], dtype=float),
+                       np.array([t_true], dtype=float), points, levels)
+    return float(found[0])

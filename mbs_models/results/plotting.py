@@ -14,6 +14,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+from ..errors import SceneError
 from ..outputs import atomic_write_bytes
 from .result import Result
 
@@ -34,16 +35,37 @@ def new_figure(rows: int = 1, cols: int = 1, *, width: float = 8.0, row_height: 
     return fig, axes
 
 
-def figure_png(fig: Figure) -> bytes:
-    """Render a figure to PNG bytes."""
+#: The file formats a figure is written in, named by the file's extension.
+FIGURE_FORMATS = ("png", "pdf", "svg")
+
+
+def figure_format(path: str | Path, key: str = "path") -> str:
+    """The format a figure file's extension names (``png``, ``pdf``, ``svg``; any case); SceneError naming
+    ``key`` for any other extension or none."""
+    suffix = Path(path).suffix.lower().lstrip(".")
+    if suffix not in FIGURE_FORMATS:
+        named = f"'.{suffix}'" if suffix else "no extension"
+        raise SceneError(key, f"{Path(path).name} has {named}: a figure is written as "
+                              f"{', '.join('.' + f for f in FIGURE_FORMATS)}")
+    return suffix
+
+
+def figure_bytes(fig: Figure, fmt: str = "png") -> bytes:
+    """Render a figure to the bytes of a file in ``fmt`` (one of :data:`FIGURE_FORMATS`)."""
     buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=FIGURE_DPI)
+    fig.savefig(buffer, format=fmt, dpi=FIGURE_DPI)
     return buffer.getvalue()
 
 
+def figure_png(fig: Figure) -> bytes:
+    """Render a figure to PNG bytes."""
+    return figure_bytes(fig, "png")
+
+
 def save_figure(fig: Figure, path: str | Path) -> Path:
-    """Write a figure as PNG atomically (temporary name, then rename)."""
-    return atomic_write_bytes(path, figure_png(fig))
+    """Write a figure atomically (temporary name, then rename) in the format its extension names (png, pdf,
+    svg); SceneError for another extension, before anything is rendered."""
+    return atomic_write_bytes(path, figure_bytes(fig, figure_format(path)))
 
 
 #: Colours of the absorbers and contacts, in order (the barrel is dark grey).
@@ -54,12 +76,20 @@ def _series_colour(i: int) -> str:
     return SERIES_COLOURS[i % len(SERIES_COLOURS)]
 
 
-def plot_result(result: Result, *, title: str | None = None) -> Figure:
+def plot_result(result: Result, *, title: str | None = None, impact_padding: float = 0.25) -> Figure:
     """Time histories of one run: positions; contact forces (one line per contact); the force on the
-    mount; velocities.  Every body and contact the scene has, none it lacks."""
+    mount; velocities; and, with an impact, a zoom on the first one (its contact's force and the force on
+    the mount over the impact's duration plus ``impact_padding`` of it either side, time in ms).  Every
+    body and contact the scene has, none it lacks."""
     contacts = list(result.contacts.values())
-    rows = 4 if contacts else 3
-    fig, axes = new_figure(rows, 1, row_height=2.4, sharex=True)
+    first_impact = result.impacts[0] if result.impacts else None
+    rows = 3 + bool(contacts) + (first_impact is not None)
+    fig, axes = new_figure(rows, 1, row_height=2.4)
+    full = [axes[i, 0] for i in range(rows - (first_impact is not None))]
+    for ax in full[1:]:
+        ax.sharex(full[0])
+    for ax in full[:-1]:
+        ax.tick_params(labelbottom=False)
     ax = axes[0, 0]
     ax.plot(result.time, result.barrel_position * 1e3, color=MODEL_COLOURS["simplified"], label="barrel $x_M$")
     for i, name in enumerate(result.absorber_names):
@@ -94,9 +124,30 @@ def plot_result(result: Result, *, title: str | None = None) -> Figure:
         ax.plot(result.time, result.velocities[name], color=_series_colour(i), lw=1.0, label=f"{name} $\\dot x_m$")
     ax.set_ylabel("velocity [m/s]")
     ax.legend(fontsize=8, loc="upper right")
-    axes[-1, 0].set_xlabel("time [s]")
+    ax.set_xlabel("time [s]")
+    if first_impact is not None:
+        _plot_impact_zoom(axes[-1, 0], result, first_impact, impact_padding)
     fig.suptitle(title or result.scene.name, fontsize=11)
     return fig
+
+
+def _plot_impact_zoom(ax, result: Result, impact, padding: float) -> None:
+    """The first impact: its contact's force and the force on the mount (kN) against time (ms)."""
+    margin = padding * impact.duration
+    mask = (result.time >= impact.start - margin) & (result.time <= impact.end + margin)
+    index = list(result.contacts).index(impact.contact)
+    force = result.contacts[impact.contact].force
+    ax.plot(result.time[mask] * 1e3, force[mask] / 1e3, ".-", color=_series_colour(index), lw=1.0, ms=3,
+            label=f"{impact.contact.replace('_', ' ')}: peak {impact.peak_force / 1e3:.1f} kN, "
+                  f"{impact.duration * 1e3:.2f} ms long")
+    ax.plot([impact.time_of_peak_force * 1e3], [impact.peak_force / 1e3], "ko", ms=4)
+    ax.plot(result.time[mask] * 1e3, result.support_force[mask] / 1e3, "-", color="#444444", lw=1.0,
+            label="force on the mount")
+    ax.axhline(0.0, color="#999999", lw=0.6)
+    ax.set_title(f"first impact (from {impact.start:.4g} s)", fontsize=9)
+    ax.set_xlabel("time [ms]")
+    ax.set_ylabel("force [kN]")
+    ax.legend(fontsize=8, loc="upper right")
 
 
 def plot_barrel_displacements(results: Sequence[Result], *, title: str) -> Figure:

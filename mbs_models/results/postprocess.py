@@ -13,155 +13,27 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..elements.barrel import BARREL
-from .peaks import HermiteTrajectory, refine_crossing, refine_function_maximum, refine_maximum, runs_of_true
+from .energies import Energies, cumulative_quadrature, energies  # noqa: F401  (re-exported)
+from .peaks import refine_crossing, refine_maximum
+from .refinement import Episodes, refine
 from .result import ALL_METRICS, ContactOutput, Impact
-
-# Gauss-Legendre nodes and weights on [0, 1], 3 points (exact for degree-5 polynomials).
-_GL_NODES = 0.5 + 0.5 * np.array([-np.sqrt(0.6), 0.0, np.sqrt(0.6)])
-_GL_WEIGHTS = np.array([5.0, 8.0, 5.0]) / 18.0
+from .samples import Interpolant, Samples
 
 
-@dataclass
-class Samples:
-    """Step-end samples of one solve: time (s), per body position/velocity/acceleration (m, m/s, m/s^2),
-    and the force (N) each recording connector (the contacts) had at each step end."""
-
-    time: np.ndarray
-    positions: dict[str, np.ndarray]
-    velocities: dict[str, np.ndarray]
-    accelerations: dict[str, np.ndarray]
-    forces: dict[str, np.ndarray] = field(default_factory=dict)
-
-
-class Interpolant:
-    """Hermite interpolation of every body's state between samples."""
-
-    def __init__(self, s: Samples):
-        self.time = s.time
-        self.x = {name: HermiteTrajectory(s.time, s.positions[name], s.velocities[name]) for name in s.positions}
-        self.v = {name: HermiteTrajectory(s.time, s.velocities[name], s.accelerations[name]) for name in s.positions}
-
-    def positions(self, t) -> dict:
-        return {name: trajectory(t) for name, trajectory in self.x.items()}
-
-    def velocities(self, t) -> dict:
-        return {name: trajectory(t) for name, trajectory in self.v.items()}
-
-
-def cumulative_quadrature(t: np.ndarray, power_at_nodes: np.ndarray) -> np.ndarray:
-    """Cumulative integral (J) over the sample intervals from the power (W) at each interval's Gauss nodes."""
-    per_interval = (power_at_nodes * _GL_WEIGHTS[None, :]).sum(axis=1) * np.diff(t)
-    return np.concatenate([[0.0], np.cumsum(per_interval)])
-
-
-def connector_force_at(mechanism, connector, interp: Interpolant, t):
-    """A connector's force (N) on the interpolated state at times ``t`` (s)."""
-    d = mechanism.relative(connector, {name: interp.x[name](t) for name in _points(connector)})
-    rate = mechanism.relative(connector, {name: interp.v[name](t) for name in _points(connector)})
-    return connector.force(d, rate, t)
-
-
-def _points(connector) -> list[str]:
-    from ..elements.connector import GROUND
-    return [p for p in (connector.a, connector.b) if p != GROUND]
+def contact_episodes(mechanism, connector, s: Samples, force: np.ndarray, interp: Interpolant,
+                     threshold: float) -> Episodes:
+    """The contact episodes of one contact, refined (:func:`~mbs_models.results.refinement.refine`)."""
+    return refine(mechanism, s.time, {connector.name: force}, interp, [connector], threshold)[0][connector.name]
 
 
 def find_impacts(mechanism, connector, s: Samples, force: np.ndarray, interp: Interpolant,
                  threshold: float) -> tuple[list[Impact], list[Impact]]:
     """Contact episodes of one contact (maximal intervals with force > 0): (all, those whose peak
-    exceeds ``threshold`` N).  Peaks are refined on the law over the interpolated state."""
-    t = s.time
-    episodes: list[Impact] = []
-
-    def force_at(x):
-        return connector_force_at(mechanism, connector, interp, x)
-
-    def force_positive(times: np.ndarray) -> np.ndarray:
-        return force_at(times) > 0.0
-
-    for i0, i1 in runs_of_true(force > 0.0):
-        k = i0 + int(np.argmax(force[i0:i1 + 1]))
-        peak, t_peak = refine_function_maximum(force_at, t, k)
-        peak = max(peak, float(force[k]))
-        if peak <= threshold:
-            episodes.append(Impact(start=float(t[i0]), end=float(t[i1]), peak_force=float(peak),
-                                   time_of_peak_force=float(t_peak), contact=connector.name))
-            continue
-        start = t[i0] if i0 == 0 else refine_crossing(force_positive, t[i0 - 1], t[i0])
-        end = t[i1] if i1 == len(t) - 1 else refine_crossing(lambda x: ~force_positive(x), t[i1], t[i1 + 1])
-        episodes.append(Impact(start=float(start), end=float(end), peak_force=float(peak),
-                               time_of_peak_force=float(t_peak), contact=connector.name))
-    return episodes, [e for e in episodes if e.peak_force > threshold]
-
-
-@dataclass
-class Energies:
-    """Energy histories at the samples (J): kinetic per body, stored and dissipated per connector, and the
-    work done on the mechanism by each external input (a load by its name, the shots of a burst by
-    their element's name).  ``kinetic + stored + dissipated - work`` stays the initial energy."""
-
-    kinetic: dict[str, np.ndarray]
-    stored: dict[str, np.ndarray]
-    dissipated: dict[str, np.ndarray]
-    work: dict[str, np.ndarray] = field(default_factory=dict)
-
-    @property
-    def kinetic_total(self) -> np.ndarray:
-        return _sum(self.kinetic.values())
-
-    @property
-    def stored_total(self) -> np.ndarray:
-        return _sum(self.stored.values())
-
-
-def _sum(arrays) -> np.ndarray | None:
-    total = None
-    for array in arrays:
-        total = array if total is None else total + array
-    return total
-
-
-def energies(mechanism, s: Samples, interp: Interpolant) -> Energies:
-    """Kinetic energy per body, stored and dissipated energy per connector, in J at the samples.
-
-    Dissipated energies are integrated with 3-point Gauss quadrature on the Hermite-interpolated state
-    in every step (each connector's own :meth:`~mbs_models.elements.connector.Connector.dissipated_energy`:
-    ``c d'^2`` for a damper, ``F p' - dU/dt`` for a contact).
-    """
-    t = s.time
-    nodes_t = t[:-1, None] + _GL_NODES[None, :] * np.diff(t)[:, None]
-    x_nodes = {name: traj.on_intervals(_GL_NODES) for name, traj in interp.x.items()}
-    v_nodes = {name: traj.on_intervals(_GL_NODES) for name, traj in interp.v.items()}
-    kinetic = {body.name: 0.5 * body.mass * s.velocities[body.name] ** 2 for body in mechanism.bodies}
-    stored: dict[str, np.ndarray] = {}
-    dissipated: dict[str, np.ndarray] = {}
-
-    def quadrature(power):
-        return cumulative_quadrature(t, power)
-
-    for connector in mechanism.connectors:
-        samples = None
-        if connector.stores_energy:
-            samples = connector.stored_energy(mechanism.relative(connector, s.positions))
-            stored[connector.name] = samples
-        if connector.dissipates:
-            dissipated[connector.name] = connector.dissipated_energy(
-                quadrature, mechanism.relative(connector, x_nodes), mechanism.relative(connector, v_nodes),
-                nodes_t, samples)
-    work: dict[str, np.ndarray] = {}
-    for load in mechanism.loads:
-        work[load.name] = load.work(quadrature, s.positions[load.body], v_nodes[load.body], nodes_t)
-    for t_shot, body, _ in mechanism.impulses:
-        jump = np.flatnonzero((t[:-1] == t_shot) & (t[1:] == t_shot))
-        if not len(jump):
-            continue  # after the end of the window (an early stop)
-        j = int(jump[0]) + 1  # the sample after the velocity jump
-        mass = mechanism.bodies[mechanism.body_index[body]].mass
-        gain = 0.5 * mass * (s.velocities[body][j] ** 2 - s.velocities[body][j - 1] ** 2)
-        name = mechanism.impulse_element[(t_shot, body)]
-        history = work.setdefault(name, np.zeros_like(t))
-        history[j:] += gain
-    return Energies(kinetic, stored, dissipated, work)
+    exceeds ``threshold`` N).  Peaks are refined on the law over the interpolated state
+    (:func:`~mbs_models.results.refinement.refine`)."""
+    episodes = contact_episodes(mechanism, connector, s, force, interp, threshold)
+    return (episodes.impacts(connector.name),
+            episodes.impacts(connector.name, episodes.peak_force > threshold))
 
 
 @dataclass
@@ -191,23 +63,27 @@ def support_force_samples(mechanism, s: Samples) -> np.ndarray:
     return total
 
 
-def _refined_support_peak(mechanism, s: Samples, interp: Interpolant, samples: np.ndarray) -> tuple[float, float]:
-    ground = [c for c in mechanism.connectors if c.support_sign]
+def _support_sample(mechanism, s: Samples, samples: np.ndarray) -> tuple[int, bool]:
+    """The sample of the largest |S| and whether there is anything to refine (a connector to the ground)."""
+    return int(np.argmax(np.abs(samples))), any(c.support_sign for c in mechanism.connectors)
+
+
+def _support_peak(s: Samples, samples: np.ndarray, k: int, refined: tuple[float, float] | None) -> tuple[float, float]:
+    """The peak |S| (N) and its time (s): the refined maximum near sample k unless the sample is larger."""
     magnitude = np.abs(samples)
-    k = int(np.argmax(magnitude))
-    if not ground:
+    if refined is None:
         return 0.0, float(s.time[k])
-
-    def at(t):
-        total = 0.0
-        for connector in ground:
-            total = total + connector.support_sign * connector_force_at(mechanism, connector, interp, t)
-        return np.abs(total)
-
-    peak, t_peak = refine_function_maximum(at, s.time, k)
+    peak, t_peak = refined
     if magnitude[k] >= peak:
         return float(magnitude[k]), float(s.time[k])
     return float(peak), float(t_peak)
+
+
+def _refined_support_peak(mechanism, s: Samples, interp: Interpolant, samples: np.ndarray) -> tuple[float, float]:
+    """The largest |support force| (N) and its time (s), refined on the interpolated state."""
+    k, grounded = _support_sample(mechanism, s, samples)
+    refined = refine(mechanism, s.time, {}, interp, [], 0.0, k)[1] if grounded else None
+    return _support_peak(s, samples, k, refined)
 
 
 def analyse(mechanism, s: Samples, impact_threshold: float, wanted: tuple[str, ...] = ALL_METRICS) -> Metrics:
@@ -225,16 +101,22 @@ def analyse(mechanism, s: Samples, impact_threshold: float, wanted: tuple[str, .
         for body in mechanism.absorber_bodies:
             metrics.max_velocity[body.name] = refine_maximum(s.time, s.velocities[body.name],
                                                              s.accelerations[body.name])
+    metrics.support_force = support_force_samples(mechanism, s)
+    searched = [c for c in mechanism.contacts] if ("impacts" in wanted or "peak_contact_force" in wanted) else []
+    k_support, grounded = _support_sample(mechanism, s, metrics.support_force)
+    refine_support = "peak_support_force" in wanted and grounded
+    episodes, refined_support = refine(mechanism, s.time, s.forces, interp, searched, impact_threshold,
+                                       k_support if refine_support else None)
     for connector in mechanism.contacts:
-        if "impacts" in wanted or "peak_contact_force" in wanted:
-            metrics.contacts[connector.name] = _contact_output(mechanism, connector, s, interp, impact_threshold)
+        if connector.name in episodes:
+            metrics.contacts[connector.name] = _contact_output(connector, s, episodes[connector.name],
+                                                               impact_threshold)
         else:  # the history only
             metrics.contacts[connector.name] = ContactOutput(connector.name, connector.element, s.forces[connector.name],
                                                              None, None, None)
-    metrics.support_force = support_force_samples(mechanism, s)
     if "peak_support_force" in wanted:
-        metrics.peak_support_force, metrics.time_of_peak_support_force = _refined_support_peak(
-            mechanism, s, interp, metrics.support_force)
+        metrics.peak_support_force, metrics.time_of_peak_support_force = _support_peak(
+            s, metrics.support_force, k_support, refined_support)
     metrics.energies = energies(mechanism, s, interp)
     metrics.shots = shot_outputs(mechanism, s, interp)
     return metrics
@@ -286,20 +168,23 @@ def shot_outputs(mechanism, s: Samples, interp: Interpolant) -> list[dict] | Non
     return out
 
 
-def _contact_output(mechanism, connector, s: Samples, interp: Interpolant, impact_threshold: float) -> ContactOutput:
-    """The episodes, impacts and refined peak force of one contact."""
+def _contact_output(connector, s: Samples, episodes: Episodes, impact_threshold: float) -> ContactOutput:
+    """The episodes, impacts and refined peak force of one contact.
+
+    The peak is the strongest impact's; failing that (no impact, or the sample maximum above every
+    impact's peak) the refined peak of the episode holding the sample maximum.
+    """
     force = s.forces[connector.name]
-    episodes, impacts = find_impacts(mechanism, connector, s, force, interp, impact_threshold)
+    impacts = episodes.impacts(connector.name, episodes.peak_force > impact_threshold)
     k = int(np.argmax(force))
     if impacts and max(i.peak_force for i in impacts) >= force[k]:
         strongest = max(impacts, key=lambda i: i.peak_force)  # already refined
         peak, t_peak = strongest.peak_force, strongest.time_of_peak_force
     elif force[k] > 0:
-        peak, t_peak = refine_function_maximum(lambda x: connector_force_at(mechanism, connector, interp, x),
-                                               s.time, k)
-        peak = max(peak, float(force[k]))
+        holding = int(np.flatnonzero(episodes.k == k)[0])  # k is the first largest sample of its episode
+        peak, t_peak = float(episodes.peak_force[holding]), float(episodes.time_of_peak_force[holding])
     else:
         peak, t_peak = 0.0, None  # no contact at all
     onsets = list(connector.capture.onsets) if getattr(connector, "capture", None) is not None else None
     return ContactOutput(name=connector.name, element=connector.element, force=force, peak_force=peak,
-                         time_of_peak_force=t_peak, impacts=impacts, episodes=len(episodes), onsets=onsets)
+                         time_of_peak_force=t_peak, impacts=impacts, episodes=len(episodes.k), onsets=onsets)

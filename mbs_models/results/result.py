@@ -252,6 +252,28 @@ class Result:
             out.append(entry)
         return out
 
+    # ------------------------------------------------------------------ the window
+    @property
+    def max_at_end_of_window(self) -> bool | None:
+        """True when the maximum barrel displacement is the last instant of the window with the barrel still
+        moving out (v > 0): the largest value *seen*, not a turning point -- a longer run would find a
+        larger maximum.  None when the maximum is not reported (an early stop that did not prove it)."""
+        if self.max_barrel_displacement is None:
+            return None
+        return bool(self.time_of_max_barrel_displacement >= self.time[-1] and self.barrel_velocity[-1] > 0.0)
+
+    def maxima_at_end_of_window(self) -> list[str]:
+        """The peak metrics whose maximum is the window's last instant (still rising there, so not a turning
+        point): ``max_barrel_displacement`` as :attr:`max_at_end_of_window` says, and ``peak_support_force``,
+        ``peak_contact_force``, ``max_absorber_velocity`` when their time is the end of the window."""
+        out = ["max_barrel_displacement"] if self.max_at_end_of_window else []
+        end = self.time[-1]
+        for name in ("peak_support_force", "peak_contact_force", "max_absorber_velocity"):
+            moment = getattr(self, f"time_of_{name}")
+            if getattr(self, name) is not None and moment is not None and moment >= end:
+                out.append(name)
+        return out
+
     # ------------------------------------------------------------------ reports
     def metrics(self) -> dict[str, Any]:
         """The scalar results as a JSON-ready dict (the keys of ``recoil run --json``)."""
@@ -266,6 +288,8 @@ class Result:
             "solver": self.settings.label(),
             "max_barrel_displacement": self.max_barrel_displacement,
             "time_of_max_barrel_displacement": self.time_of_max_barrel_displacement,
+            "max_at_end_of_window": self.max_at_end_of_window,
+            "maxima_at_end_of_window": self.maxima_at_end_of_window(),
             "peak_support_force": self.peak_support_force,
             "time_of_peak_support_force": self.time_of_peak_support_force,
             "peak_contact_force": self.peak_contact_force,
@@ -302,16 +326,23 @@ class Result:
         window = f"{self.end_time:g} s"
         if self.stop_reason != "end_time":
             window += f" of {self.requested_end_time:g} s requested ({self.stop_reason.replace('_', ' ')})"
-        lines = [f"{self.scene.name} ({self.scene.model_label}), {window}, {self.settings.label()}"]
+        name, label = self.scene.name, self.scene.model_label
+        header = name if label.lower() in name.lower() else f"{name} ({label})"  # the model named once
+        lines = [f"{header}, {window}, {self.settings.label()}"]
         not_final = "not proven final (run stopped early)"
+        at_end = self.maxima_at_end_of_window()
+
+        def end_note(name: str) -> str:
+            return " (the end of the window: still rising, not a turning point)" if name in at_end else ""
+
         if self.max_barrel_displacement is not None:
             lines.append(f"  max barrel displacement  {self.max_barrel_displacement:.6f} m at "
-                         f"{self.time_of_max_barrel_displacement:.5f} s")
+                         f"{self.time_of_max_barrel_displacement:.5f} s{end_note('max_barrel_displacement')}")
         else:
             lines.append(f"  max barrel displacement  {not_final}")
         if self.peak_support_force is not None:
             lines.append(f"  peak support force       {self.peak_support_force / 1e3:.3f} kN at "
-                         f"{self.time_of_peak_support_force:.5f} s")
+                         f"{self.time_of_peak_support_force:.5f} s{end_note('peak_support_force')}")
         else:
             lines.append(f"  peak support force       {not_final}")
         if self.scene.has_absorber:
@@ -321,12 +352,12 @@ class Result:
                 lines.append("  peak contact force       0 (no contact)")
             else:
                 lines.append(f"  peak contact force       {self.peak_contact_force / 1e3:.3f} kN at "
-                             f"{self.time_of_peak_contact_force:.5f} s")
+                             f"{self.time_of_peak_contact_force:.5f} s{end_note('peak_contact_force')}")
             if self.max_absorber_velocity is None:
                 lines.append(f"  max absorber velocity    {not_final}")
             else:
                 lines.append(f"  max absorber velocity    {self.max_absorber_velocity:.5f} m/s at "
-                             f"{self.time_of_max_absorber_velocity:.5f} s")
+                             f"{self.time_of_max_absorber_velocity:.5f} s{end_note('max_absorber_velocity')}")
             impacts = not_final if self.impacts is None else len(self.impacts)
             lines.append(f"  impacts (> {self.impact_threshold / 1e3:g} kN)      {impacts}")
         for stop in self.stops():
@@ -348,6 +379,9 @@ class Result:
         supplied = self.kinetic_energy_history[0] + self.stored_energy_history[0] + sum(firing.get("work", {}).values())
         lines.append(f"  energy dissipated        {self.total_dissipated_energy:.2f} J of "
                      f"{supplied:.2f} J" + (" (with the work of the inputs)" if "work" in firing else ""))
+        if at_end:
+            lines.append("  a maximum at the end of the window is only the largest value seen: run longer for "
+                         "the turning point")
         lines.append(f"  wall time                {self.wall_time * 1e3:.1f} ms ({self.steps} steps)")
         return "\n".join(lines)
 

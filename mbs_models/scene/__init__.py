@@ -4,6 +4,8 @@
   :mod:`mbs_models.elements` and the paper's readings;
 * :func:`load_scene`, :func:`scene_from_dict`, :func:`scene_to_dict`, :func:`scene_to_toml`
   (:mod:`.io`): TOML versions 1 and 2;
+* :func:`apply_overrides`, :func:`parse_spec`, :func:`parse_value` (:mod:`.overrides`): dotted keys
+  (``contact.gap``, ``absorber.0.mass``) that change a scene's fields, and sweep specs;
 * :func:`simplified_model`, :func:`model_i`, :func:`model_ii`, :func:`paper_model` (:mod:`.models`): the
   paper's three models with Table 1's parameters.
 
@@ -15,6 +17,7 @@ from ..elements.absorber import MOUNTS
 from ..elements.contact_laws import CONTACT_LAWS
 from .container import PAPER_ROUNDED_INITIAL_VELOCITY, Conventions, Scene
 from .io import FORMAT_VERSION, FORMAT_VERSIONS, load_scene, scene_from_dict, scene_to_dict, scene_to_toml
+from .overrides import apply_overrides, parse_spec, parse_value
 from .models import model_i, model_ii, paper_model, simplified_model
 
 #: Every element's table class by its class name (``Barrel``, ``RecoilSpring``, ``Contact``, ...): re-exported
@@ -24,4 +27,4 @@ globals().update(TABLE_CLASSES)
 
 __all__ = ["Scene", "Conventions", *TABLE_CLASSES, "TABLE_CLASSES", "CONTACT_LAWS", "MOUNTS",
            "PAPER_ROUNDED_INITIAL_VELOCITY", "FORMAT_VERSION", "FORMAT_VERSIONS", "load_scene", "scene_from_dict",
-           "scene_to_dict", "scene_to_toml", "model_i", "model_ii", "paper_model", "simplified_model"]
+           "scene_to_dict", "scene_to_toml", "apply_overrides", "parse_spec", "parse_value", "model_i", "model_ii", "paper_model", "simplified_model"]

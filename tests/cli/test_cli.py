@@ -93,6 +93,7 @@ def test_run_simplified_json_has_null_contact_metrics(capsys):
 
 
 def test_run_plot_writes_png(tmp_path, capsys):
+    (tmp_path / "plots").mkdir()
     target = tmp_path / "plots" / "run.png"
     assert main(["run", "model_i", "--end-time", "1", "--plot", str(target)]) == 0
     assert target.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
@@ -143,3 +144,48 @@ def test_run_plot_of_several_absorbers(tmp_path, capsys):
     assert main(["run", "two_absorbers", "--end-time", "1", "--plot", str(path)]) == 0
     assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert "peak support force" in capsys.readouterr().out
+
+
+def test_version_prints_the_package_version():
+    from mbs_models import __version__
+
+    proc = subprocess.run([sys.executable, "-m", "mbs_models", "--version"], capture_output=True, text=True)
+    assert proc.returncode == 0 and proc.stdout.strip() == f"recoil {__version__}"
+
+
+@pytest.mark.parametrize("command", ["run", "validate", "contact-laws", "design-brake"])
+def test_accuracy_help_shows_the_default_and_what_each_preset_means(capsys, command):
+    with pytest.raises(SystemExit) as exit_info:
+        main([command, "--help"])
+    assert exit_info.value.code == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert "(default: standard)" in text
+    for preset in ("draft =", "standard =", "reference ="):
+        assert preset in text, preset
+
+
+def test_validate_table_has_a_unit_column(capsys):
+    assert main(["validate", "model_ii", "--end-time", "0.5", "--accuracy", "draft"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[1].split()[:2] == ["quantity", "unit"]
+    units = {line.split()[0]: line.split()[1] for line in lines[2:-1]}
+    assert units["max_barrel_displacement"] == "m" and units["time_of_max_barrel_displacement"] == "s"
+    assert units["peak_contact_force"] == "N" and units["max_absorber_velocity"] == "m/s"
+    assert units["peak_support_force"] == "N"
+
+
+def test_validate_warns_of_a_contact_that_cannot_close(tmp_path, capsys):
+    path = tmp_path / "mm.toml"
+    path.write_text(scene_to_toml(model_ii(1000.0, 40.0)))
+    main(["validate", str(path), "--end-time", "0.5", "--accuracy", "draft"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("recoil: warning: absorber.contact.gap = 40 m")
+
+
+def test_output_piped_into_a_reader_that_stops_gives_no_traceback():
+    """``recoil run ... | head -1``: the reader closes the pipe; no traceback, the run's exit code."""
+    proc = subprocess.Popen([sys.executable, "-m", "mbs_models", "run", "model_ii", "--end-time", "0.2",
+                             "--accuracy", "draft"], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc.stdout.close()  # before the process writes anything (it is still importing)
+    err = proc.stderr.read().decode()
+    assert proc.wait() == 0 and "Traceback" not in err and "BrokenPipe" not in err, err

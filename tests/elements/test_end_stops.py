@@ -357,3 +357,19 @@ def test_the_brake_design_refuses_a_recoil_length_beyond_the_recoil_stop():
     with pytest.raises(SceneError, match=r"shorter than the position of \[recoil_stop\] \(0.2 m\)"):
         design_brake(simplified_model().with_changes(recoil_stop=stop), 0.22)
     assert design_brake(simplified_model().with_changes(recoil_stop=stop), 0.18).recoil_length == 0.18
+
+
+def test_a_recoil_stop_out_of_reach_names_its_position():
+    """A stop position typed in mm (120 for 120 mm) is reported before any solve (mbs_models/engine/reach.py),
+    with the undamped free recoil's sqrt(2 E0 / k) as the barrel's reach."""
+    import math
+
+    from mbs_models.engine.final_metrics import ENERGY_SLACK
+    from mbs_models.engine.reach import contacts_out_of_reach
+
+    scene = load_scene(scene_path("end_stops")).with_changes(**{"recoil_stop.position": 120.0})
+    [found] = contacts_out_of_reach(scene)
+    assert found.key == "recoil_stop.position" and found.length == 120.0
+    energy = 0.5 * scene.barrel.mass * scene.initial_velocity ** 2
+    assert found.reach == pytest.approx(math.sqrt(2.0 * energy * (1.0 + ENERGY_SLACK) / scene.recoil_spring.stiffness),
+                                        rel=1e-9)

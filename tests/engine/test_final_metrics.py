@@ -14,7 +14,7 @@ import pytest
 
 from mbs_models import Conventions, SceneError, model_i, model_ii, simplified_model, simulate
 from mbs_models.engine import final_metrics as fm
-from mbs_models.studies.sweep import run_sweep
+from mbs_models.studies.sweep import run_scenes
 
 ALL = fm.FINAL_METRICS
 TIMES = {"max_barrel_displacement": "time_of_max_barrel_displacement",
@@ -144,7 +144,7 @@ def test_bad_metric_names_raise_scene_error_naming_the_argument(bad):
     assert info.value.key == "stop_when_final"
     assert "max_barrel_displacement, peak_contact_force" in info.value.message
     with pytest.raises(SceneError, match="stop_when_final"):
-        run_sweep([model_ii()], 1.0, stop_when_final=bad)
+        run_scenes([model_ii()], 1.0, stop_when_final=bad)
 
 
 # --------------------------------------------------------------------------- the bounds themselves
@@ -245,8 +245,8 @@ def test_tracker_on_a_simple_state():
 
 def test_sweep_with_early_stop_gives_the_same_displacements():
     scenes = [model_i(500.0, 0.0), model_ii(100.0, 0.05), model_ii(1000.0, 0.0, Conventions(literal_lambda_sign=True))]
-    early = run_sweep(scenes, 4.0, workers=1, stop_when_final=("max_barrel_displacement",))
-    full = run_sweep(scenes, 4.0, workers=1)
+    early = run_scenes(scenes, 4.0, workers=1, stop_when_final=("max_barrel_displacement",))
+    full = run_scenes(scenes, 4.0, workers=1)
     for a, b in zip(early, full):
         assert a.error is None and a.max_barrel_displacement == b.max_barrel_displacement
         assert a.time_of_max_barrel_displacement == b.time_of_max_barrel_displacement

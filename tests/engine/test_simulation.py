@@ -171,3 +171,16 @@ def test_solver_that_stops_early_with_success_is_a_simulation_error(monkeypatch,
     monkeypatch.setattr(simulation, "exudyn_simulation_settings", stopping_halfway)
     with pytest.raises(SimulationError, match="stopped early at t = 0.5 s"):
         simulate(factory(), 1.0)
+
+
+def test_the_docstring_example_of_simulate_holds():
+    """help(simulate) shows an example: its printed numbers are the library's."""
+    import doctest
+
+    from mbs_models.engine import simulation
+
+    finder = doctest.DocTestFinder()
+    [test] = [t for t in finder.find(simulation.simulate, "simulate", globs={}) if t.examples]
+    runner = doctest.DocTestRunner(optionflags=doctest.ELLIPSIS)
+    runner.run(test)
+    assert runner.summarize(verbose=False).failed == 0 and len(test.examples) >= 3

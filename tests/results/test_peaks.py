@@ -46,3 +46,14 @@ def test_refine_crossing_finds_switch_time():
 ])
 def test_runs_of_true(flags, runs):
     assert runs_of_true(np.array(flags, dtype=bool)) == runs
+
+
+def test_run_argmax_is_argmax_per_run():
+    from mbs_models.results.peaks import run_argmax, run_bounds
+    rng = np.random.default_rng(3)
+    values = np.round(rng.normal(size=500), 1)  # ties within runs: the first largest
+    first, last = run_bounds(values > -0.3)
+    k = run_argmax(values, first, last)
+    assert list(zip(first.tolist(), last.tolist())) == runs_of_true(values > -0.3)
+    assert k.tolist() == [i0 + int(np.argmax(values[i0:i1 + 1])) for i0, i1 in zip(first, last)]
+    assert len(run_argmax(values, first[:0], last[:0])) == 0

@@ -49,9 +49,28 @@ class QuantityCheck:
             return True  # the quantity does not exist in this scene (e.g. no absorber)
         return self.relative_error is not None and self.relative_error <= self.tolerance
 
+    @property
+    def unit(self) -> str:
+        """The SI unit of the engine and reference values, from the quantity's name (a position history's
+        values are not shown: its error is relative to the history's largest magnitude)."""
+        return quantity_unit(self.name)
+
     def to_dict(self) -> dict:
-        return {"name": self.name, "engine": self.engine, "reference": self.reference,
+        return {"name": self.name, "unit": self.unit, "engine": self.engine, "reference": self.reference,
                 "relative_error": self.relative_error, "tolerance": self.tolerance, "passed": self.passed}
+
+
+def quantity_unit(name: str) -> str:
+    """``s`` for a time, ``N`` for a force, ``m/s`` for a velocity, ``m`` for a displacement or position."""
+    if name.startswith("time_of_"):
+        return "s"
+    if name.endswith("force"):
+        return "N"
+    if "velocity" in name:
+        return "m/s"
+    if "displacement" in name or "position" in name:
+        return "m"
+    raise ValueError(f"no unit known for the quantity {name!r}")
 
 
 @dataclass
@@ -94,15 +113,16 @@ class Comparison:
     def table(self) -> str:
         """A small text table (used by ``recoil validate``)."""
         lines = [f"{self.scene.name}: engine ({self.accuracy}) vs reference, {self.end_time:g} s",
-                 f"{'quantity':34s} {'engine':>14s} {'reference':>14s} {'rel. error':>11s} {'tolerance':>9s}  ok"]
+                 f"{'quantity':34s} {'unit':4s} {'engine':>14s} {'reference':>14s} {'rel. error':>11s} "
+                 f"{'tolerance':>9s}  ok"]
         for c in self.checks:
             if c.engine is None and c.reference is None and c.relative_error is None:
                 continue
             fmt = lambda v: "-" if v is None else f"{v:14.7g}"  # noqa: E731
             err = "-" if c.relative_error is None else f"{c.relative_error:11.2e}"
-            lines.append(f"{c.name:34s} {fmt(c.engine):>14s} {fmt(c.reference):>14s} {err:>11s} "
+            lines.append(f"{c.name:34s} {c.unit:4s} {fmt(c.engine):>14s} {fmt(c.reference):>14s} {err:>11s} "
                          f"{c.tolerance:9.0e}  {'yes' if c.passed else 'NO'}")
-        lines.append(f"{'impacts (> threshold)':34s} {self.engine_impacts:14d} {self.reference_impacts:14d} "
+        lines.append(f"{'impacts (> threshold)':34s} {'-':4s} {self.engine_impacts:14d} {self.reference_impacts:14d} "
                      f"{'':11s} {'equal':>9s}  {'yes' if self.impacts_match else 'NO'}")
         lines.append("PASSED" if self.passed else f"FAILED: {', '.join(self.failures)}")
         return "\n".join(lines)

@@ -1,0 +1,77 @@
+"""``recoil run``: simulate one scene, print its metrics, optionally write the plot and the time histories.
+
+Every output is checked before the solve (exit 2, nothing written, for a figure format other than
+png/pdf/svg or a missing or unwritable directory), and contacts that can never close are reported on
+stderr (:func:`mbs_models.engine.reach.contacts_out_of_reach`) before the solve too.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+
+
+def add_parser(sub, accuracy_help: str) -> None:
+    """The ``run`` subcommand's arguments."""
+    from .sweep import add_set_argument
+
+    run = sub.add_parser("run", help="simulate one scene and print its metrics")
+    run.add_argument("scene", help="scene TOML file, or the name of a shipped scene (see the README: model_i, "
+                                   "model_ii, two_absorbers, ...)")
+    run.add_argument("--end-time", type=float, default=10.0, help="simulated time in s (default 10)")
+    run.add_argument("--accuracy", default="standard", choices=("draft", "standard", "reference"),
+                     help=accuracy_help)
+    run.add_argument("--json", action="store_true", help="print the metrics as one JSON object")
+    run.add_argument("--plot", metavar="FILE",
+                     help="write the time histories and a zoom on the first impact as a figure; the extension "
+                          "names the format: .png, .pdf or .svg (the directory must exist)")
+    run.add_argument("--csv", metavar="FILE",
+                     help="write the time histories (time, positions, velocities, accelerations, every contact "
+                          "force, the force on the mount, energies) as CSV, units in the header")
+    run.add_argument("--user-functions", choices=("symbolic", "python"), default=None,
+                     help="user-function backend (default symbolic; python is slower, for debugging)")
+    run.add_argument("--impact-threshold", type=float, default=1000.0,
+                     help="peak force (N) above which a contact episode counts as an impact (default 1000)")
+    add_set_argument(run)
+    run.set_defaults(handler=command)
+
+
+def warn_out_of_reach(scene) -> None:
+    """One line on stderr per contact that can never close (a gap in mm instead of m...)."""
+    from ..engine.reach import contacts_out_of_reach
+
+    for found in contacts_out_of_reach(scene):
+        print(f"recoil: warning: {found.message()}", file=sys.stderr, flush=True)
+
+
+def command(args) -> int:
+    from ..engine.simulation import simulate
+    from ..outputs import check_output_file
+    from . import EXIT_OK, _resolve_scene
+    from .sweep import apply_sets
+
+    scene = apply_sets(_resolve_scene(args.scene), args.set)
+    if args.plot:
+        from ..results.plotting import figure_format
+        figure_format(args.plot, key="--plot")
+        check_output_file(args.plot, key="--plot")
+    if args.csv:
+        check_output_file(args.csv, key="--csv")
+    warn_out_of_reach(scene)
+    result = simulate(scene, args.end_time, args.accuracy, user_functions=args.user_functions,
+                      impact_threshold=args.impact_threshold)
+    if args.plot:
+        from ..results.plotting import plot_result, save_figure
+        save_figure(plot_result(result), args.plot)
+    if args.csv:
+        from ..results.histories import write_histories_csv
+        write_histories_csv(result, args.csv)
+    if args.json:
+        print(json.dumps(result.metrics(), indent=2, allow_nan=False))
+    else:
+        print(result.summary())
+        if args.plot:
+            print(f"  plot                     {args.plot}")
+        if args.csv:
+            print(f"  time histories (CSV)     {args.csv}")
+    return EXIT_OK

@@ -1,0 +1,64 @@
+"""The step-end samples of a solve and their Hermite interpolation between samples.
+
+Positions are interpolated from velocities and velocities from accelerations (cubic Hermite,
+:mod:`mbs_models.results.hermite`); every body's state comes from one interval search and one set of
+basis polynomials.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .hermite import HermiteStack, HermiteTrajectory
+
+
+@dataclass
+class Samples:
+    """Step-end samples of one solve: time (s), per body position/velocity/acceleration (m, m/s, m/s^2),
+    and the force (N) each recording connector (the contacts) had at each step end."""
+
+    time: np.ndarray
+    positions: dict[str, np.ndarray]
+    velocities: dict[str, np.ndarray]
+    accelerations: dict[str, np.ndarray]
+    forces: dict[str, np.ndarray] = field(default_factory=dict)
+
+
+class Interpolant:
+    """Hermite interpolation of every body's state between samples.
+
+    ``x[name]``, ``v[name]``: one body's position and velocity; :meth:`state` and :meth:`on_intervals`
+    give every body's at once (one interval search and one set of basis polynomials for all; the same
+    values as the single trajectories, bit for bit).
+    """
+
+    def __init__(self, s: Samples):
+        self.time = s.time
+        self.names = list(s.positions)
+        self.x = {name: HermiteTrajectory(s.time, s.positions[name], s.velocities[name]) for name in s.positions}
+        self.v = {name: HermiteTrajectory(s.time, s.velocities[name], s.accelerations[name]) for name in s.positions}
+        self._stack = HermiteStack(s.time, np.array([s.positions[n] for n in self.names]
+                                                     + [s.velocities[n] for n in self.names]).reshape(-1, len(s.time)),
+                                   np.array([s.velocities[n] for n in self.names]
+                                            + [s.accelerations[n] for n in self.names]).reshape(-1, len(s.time)))
+
+    def _split(self, values) -> tuple[dict, dict]:
+        n = len(self.names)
+        return ({name: values[i] for i, name in enumerate(self.names)},
+                {name: values[n + i] for i, name in enumerate(self.names)})
+
+    def state(self, t) -> tuple[dict, dict]:
+        """Every body's position (m) and velocity (m/s) at times ``t`` (s, any shape)."""
+        return self._split(self._stack(t))
+
+    def on_intervals(self, fractions) -> tuple[dict, dict]:
+        """Every body's position and velocity at ``t_i + f h_i``, shape (intervals, fractions) each."""
+        return self._split(self._stack.on_intervals(fractions))
+
+    def positions(self, t) -> dict:
+        return self.state(t)[0]
+
+    def velocities(self, t) -> dict:
+        return self.state(t)[1]

@@ -1,0 +1,59 @@
+"""``recoil optimise``: writes the optimum, history and figure; no feasible design is exit 1; bad input exit 2."""
+
+from __future__ import annotations
+
+import json
+
+import pandas as pd
+import pytest
+
+from mbs_models.cli import main
+
+SMALL = ["--popsize", "3", "--maxiter", "1", "--workers", "1"]
+
+
+def test_writes_results(tmp_path, capsys):
+    out = tmp_path / "opt"
+    code = main(["optimise", "model_i", "--vary", "contact.gap=0:0.12", "--minimise", "max_barrel_displacement",
+                 "--constraint", "peak_support_force<=7000", "--out", str(out), "--json", *SMALL])
+    captured = capsys.readouterr()
+    assert code == 0, captured.err
+    data = json.loads(captured.out)
+    assert data["feasible"] and data["constraints"][0]["satisfied"]
+    assert data["settings"]["seed"] == 1 and data["settings"]["population"] == 5  # scipy's smallest
+    assert sorted(p.name for p in out.iterdir()) == ["convergence.csv", "history.csv", "optimise.png", "optimum.json"]
+    history = pd.read_csv(out / "history.csv")
+    assert len(history) == data["evaluations"] and "contact.gap" in history.columns
+    assert json.loads((out / "optimum.json").read_text()) == data
+    assert "generation 0" in captured.err
+
+
+def test_no_feasible_design_is_exit_1(tmp_path, capsys):
+    code = main(["optimise", "model_i", "--vary", "contact.gap=0:0.12", "--minimise", "peak_support_force",
+                 "--constraint", "max_barrel_displacement<=0.05", "--out", str(tmp_path / "o"), *SMALL])
+    captured = capsys.readouterr()
+    assert code == 1 and "NO FEASIBLE DESIGN FOUND" in captured.out
+    assert (tmp_path / "o" / "optimum.json").exists()
+
+
+@pytest.mark.parametrize("args, text", [
+    (["--vary", "contact.gap=0:0.12", "--minimise", "max_barrel_displacment"],
+     "--minimise: unknown metric 'max_barrel_displacment'; did you mean 'max_barrel_displacement'?"),
+    (["--minimise", "max_barrel_displacement"], "--vary: give at least one parameter"),
+    (["--vary", "contact.gap=0.1:0", "--minimise", "max_barrel_displacement"], "contact.gap: bounds must be"),
+    (["--vary", "contact.gap=0:a", "--minimise", "max_barrel_displacement"], "--vary"),
+    (["--vary", "absorber.mass=0:100", "--minimise", "max_barrel_displacement"], "absorber.mass"),
+    (["--vary", "contact.gap=0:0.1", "--minimise", "max_barrel_displacement", "--constraint", "x<1"],
+     "--constraint: must be METRIC<=VALUE"),
+    (["--vary", "contact.gap=0:0.1", "--vary", "contact.gap=0:0.2", "--minimise", "max_barrel_displacement"],
+     "given twice"),
+    (["--vary", "contact.gap=0:0.1", "--minimise", "max_barrel_displacement", "--popsize", "0"], "--popsize"),
+    (["--vary", "contact.gap=0:0.1"], "--minimise"),
+])
+def test_bad_input_is_one_line_exit_2_and_writes_nothing(tmp_path, capsys, args, text):
+    out = tmp_path / "never"
+    assert main(["optimise", "model_i", *args, "--out", str(out)]) == 2
+    captured = capsys.readouterr()
+    lines = captured.err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("recoil: error:") and text in lines[0], captured.err
+    assert captured.out == "" and not out.exists()

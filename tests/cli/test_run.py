@@ -1,0 +1,138 @@
+"""``recoil run`` (mbs_models/cli/run.py): outputs in the format asked, checked before the solve; the warning
+for contacts that cannot close; the end of the window; the time histories as CSV."""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import os
+import stat
+
+import numpy as np
+import pytest
+
+from mbs_models import model_ii, scene_to_toml, simulate
+from mbs_models.cli import main
+
+_PNG = b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.fixture
+def no_solve(monkeypatch):
+    """Make any solve fail loudly: the checks under test must come before it."""
+    import mbs_models.engine.simulation as simulation
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("simulate() was called")
+
+    monkeypatch.setattr(simulation, "simulate", refuse)
+
+
+@pytest.mark.parametrize("name, magic", [("run.png", _PNG), ("run.PNG", _PNG), ("run.pdf", b"%PDF-"),
+                                         ("run.svg", b"<?xml")])
+def test_the_plot_is_written_in_the_format_its_extension_names(tmp_path, capsys, name, magic):
+    target = tmp_path / name
+    assert main(["run", "model_ii", "--end-time", "0.3", "--accuracy", "draft", "--plot", str(target)]) == 0
+    data = target.read_bytes()
+    assert data.startswith(magic)
+    if name.endswith(".svg"):
+        assert b"<svg" in data[:2000]
+
+
+@pytest.mark.parametrize("name", ["run.jpg", "run", "run.png.txt"])
+def test_another_figure_format_is_refused_before_the_solve(tmp_path, capsys, no_solve, name):
+    target = tmp_path / name
+    assert main(["run", "model_ii", "--plot", str(target)]) == 2
+    captured = capsys.readouterr()
+    [line] = captured.err.strip().splitlines()
+    assert line.startswith("recoil: error: --plot:") and ".png, .pdf, .svg" in line
+    assert captured.out == "" and list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("option, name", [("--plot", "run.png"), ("--csv", "run.csv")])
+def test_a_missing_directory_is_refused_and_not_created(tmp_path, capsys, no_solve, option, name):
+    target = tmp_path / "no" / "such" / "dir" / name
+    assert main(["run", "model_ii", option, str(target)]) == 2
+    [line] = capsys.readouterr().err.strip().splitlines()
+    assert line.startswith(f"recoil: error: {option}:") and "does not exist" in line
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_directory_as_csv_target_is_refused(tmp_path, capsys, no_solve):
+    assert main(["run", "model_ii", "--csv", str(tmp_path)]) == 2
+    assert "is a directory" in capsys.readouterr().err
+
+
+def test_outputs_honour_the_umask(tmp_path, capsys):
+    saved = os.umask(0o022)
+    try:
+        assert main(["run", "model_ii", "--end-time", "0.2", "--accuracy", "draft",
+                     "--plot", str(tmp_path / "run.png"), "--csv", str(tmp_path / "run.csv")]) == 0
+    finally:
+        os.umask(saved)
+    for name in ("run.png", "run.csv"):
+        assert stat.S_IMODE((tmp_path / name).stat().st_mode) == 0o644, name
+
+
+def test_a_gap_in_millimetres_warns_on_one_line_and_still_runs(tmp_path, capsys):
+    path = tmp_path / "mm.toml"
+    path.write_text(scene_to_toml(model_ii(1000.0, 40.0)))
+    assert main(["run", str(path), "--end-time", "1", "--accuracy", "draft"]) == 0
+    captured = capsys.readouterr()
+    [line] = captured.err.strip().splitlines()
+    k, e0 = 27500.0, 0.5 * 5600.0 * model_ii().initial_velocity ** 2
+    reach = math.sqrt(2.0 * e0 / k)  # the undamped free recoil's amplitude
+    assert line.startswith("recoil: warning: absorber.contact.gap = 40 m")
+    assert float(line.split("(")[1].split()[0]) == pytest.approx(reach, rel=1e-3)
+    assert "no contact" in captured.out
+
+
+def test_no_warning_for_a_contact_that_closes(capsys):
+    assert main(["run", "model_ii", "--end-time", "0.2", "--accuracy", "draft"]) == 0
+    assert capsys.readouterr().err == ""
+
+
+def test_a_maximum_at_the_end_of_the_window_is_flagged(capsys):
+    assert main(["run", "model_ii", "--end-time", "0.001", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["time_of_max_barrel_displacement"] == data["end_time"] == 0.001
+    assert data["max_at_end_of_window"] is True
+    assert "max_barrel_displacement" in data["maxima_at_end_of_window"]
+    assert main(["run", "model_ii", "--end-time", "0.001"]) == 0
+    line = next(l for l in capsys.readouterr().out.splitlines() if "max barrel displacement" in l)
+    assert "not a turning point" in line
+
+
+def test_a_turning_point_is_not_flagged(capsys):
+    assert main(["run", "model_ii", "--end-time", "1", "--json", "--accuracy", "draft"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["time_of_max_barrel_displacement"] < 0.9 and data["max_at_end_of_window"] is False
+    assert data["maxima_at_end_of_window"] == []
+    assert main(["run", "model_ii", "--end-time", "1", "--accuracy", "draft"]) == 0
+    assert "turning point" not in capsys.readouterr().out
+
+
+def test_the_header_names_the_model_once(capsys):
+    assert main(["run", "model_ii", "--end-time", "0.1", "--accuracy", "draft"]) == 0
+    header = capsys.readouterr().out.splitlines()[0]
+    assert header.count("model (ii)") == 1
+
+
+def test_csv_has_the_time_histories_with_units(tmp_path, capsys):
+    target = tmp_path / "run.csv"
+    assert main(["run", "model_ii", "--end-time", "0.5", "--accuracy", "draft", "--csv", str(target)]) == 0
+    with target.open(newline="") as stream:
+        rows = list(csv.reader(stream))
+    header, values = rows[0], np.array(rows[1:], dtype=float)
+    assert all(name.endswith("]") and " [" in name for name in header)
+    expected = simulate(model_ii(), 0.5, "draft")
+    column = {name: values[:, i] for i, name in enumerate(header)}
+    np.testing.assert_array_equal(column["time [s]"], expected.time)
+    np.testing.assert_array_equal(column["barrel position [m]"], expected.barrel_position)
+    np.testing.assert_array_equal(column["absorber velocity [m/s]"], expected.absorber_velocity)
+    np.testing.assert_array_equal(column["contact force [N]"], expected.contact_force)
+    np.testing.assert_array_equal(column["support force [N]"], expected.support_force)
+    for name in ("kinetic energy [J]", "stored energy [J]", "dissipated energy [J]", "energy balance error [J]"):
+        assert name in column
+    assert "time histories (CSV)" in capsys.readouterr().out

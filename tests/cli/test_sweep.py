@@ -1,0 +1,136 @@
+"""``recoil sweep`` and ``--set`` (mbs_models.cli.sweep): the table, resuming, one-line errors with exit 2."""
+
+from __future__ import annotations
+
+import json
+
+import pandas as pd
+import pytest
+
+from mbs_models import model_i, simulate
+from mbs_models.cli import main
+
+GRID = ["--param", "absorber.mass=100,1000", "--param", "contact.gap=0:0.04:2"]
+
+
+def test_sweep_writes_the_table_and_resumes(tmp_path, capsys):
+    out = tmp_path / "gaps.csv"
+    argv = ["sweep", "model_i", *GRID, "--out", str(out), "--end-time", "1", "--workers", "2"]
+    assert main(argv) == 0
+    printed = capsys.readouterr().out
+    assert "4 points: 4 run, 0 resumed" in printed and "0 failed" in printed and str(out) in printed
+    table = pd.read_csv(out)
+    assert table[["absorber.mass", "contact.gap"]].values.tolist() == [[100, 0], [100, 0.04], [1000, 0], [1000, 0.04]]
+    for row in table.to_dict("records"):
+        expected = simulate(model_i(row["absorber.mass"], row["contact.gap"]), 1.0).max_barrel_displacement
+        assert row["max_barrel_displacement"] == expected
+    assert main(argv) == 0
+    assert "4 points: 0 run, 4 resumed" in capsys.readouterr().out
+    pd.testing.assert_frame_equal(pd.read_csv(out), table)
+
+
+def test_sweep_json_summary_lists_the_failures(tmp_path, capsys):
+    out = tmp_path / "f.csv"
+    assert main(["sweep", "model_ii", "--param", "conventions.compression_only=false,true", "--out", str(out),
+                 "--end-time", "0.5", "--workers", "1", "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["points"] == 2 and summary["failed"] == 1 and summary["out"] == str(out)
+    assert summary["failures"][0]["conventions.compression_only"] is True
+    assert summary["failures"][0]["status"] == "SimulationError" and "step budget" in summary["failures"][0]["error"]
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (["--param", "contact.gapp=0,1"], "contact.gapp: unknown key; did you mean 'gap'?"),
+    (["--param", "contact.gap=0:1"], "contact.gap: a range is START:STOP:COUNT"),
+    (["--param", "contact.gap=0:1:1"], "contact.gap: COUNT"),
+    (["--param", "contact.gap=-1,-2"], "contact.gap: must be >= 0 m"),
+    (["--param", "absorber.mass=1,heavy"], "absorber.mass: must be a number"),
+    (["--param", "contact.gap"], "--param: expected KEY=SPEC"),
+    (["--param", "contact.gap=0", "--param", "contact.gap=1"], "contact.gap: given twice"),
+    (["--param", "absorber.1.mass=1"], "absorber.1.mass: the scene has 1 absorber(s)"),
+    (["--param", "contact.gap=0", "--workers", "0"], "--workers: must be a whole number >= 1"),
+    (["--param", "contact.gap=0", "--workers", "2", "--scheduler", "tcp://127.0.0.1:1"], "--workers: give either"),
+    (["--param", "contact.gap=0", "--end-time", "-1"], "--end-time: must be a number of seconds"),
+    (["--param", "contact.gap=0", "--out-file", "x"], "unrecognized arguments"),
+])
+def test_bad_input_exits_2_with_one_line(tmp_path, capsys, argv, needle):
+    out = tmp_path / "s.csv"
+    code = main(["sweep", "model_i", *argv, "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert needle in err and len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("out, needle", [("s.txt", "--out: must be a .csv or .parquet file"),
+                                         ("missing/s.csv", "--out: the directory")])
+def test_bad_out_exits_2(tmp_path, capsys, out, needle):
+    assert main(["sweep", "model_i", "--param", "contact.gap=0", "--out", str(tmp_path / out)]) == 2
+    assert needle in capsys.readouterr().err
+
+
+def test_missing_param_or_out_exits_2(capsys):
+    assert main(["sweep", "model_i", "--out", "x.csv"]) == 2
+    assert "--param" in capsys.readouterr().err
+    assert main(["sweep", "model_i", "--param", "contact.gap=0"]) == 2
+    assert "--out" in capsys.readouterr().err
+
+
+def test_an_unreachable_scheduler_exits_2(tmp_path, capsys):
+    pytest.importorskip("dask.distributed")
+    out = tmp_path / "s.csv"
+    assert main(["sweep", "model_i", "--param", "contact.gap=0", "--out", str(out),
+                 "--scheduler", "tcp://127.0.0.1:1"]) == 2
+    assert "--scheduler: cannot connect" in capsys.readouterr().err and not out.exists()
+
+
+def test_run_set_changes_the_scene_and_says_so(capsys):
+    assert main(["run", "model_i", "--set", "absorber.mass=500", "--set", "contact.gap=0.04", "--end-time", "1",
+                 "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["max_barrel_displacement"] == simulate(model_i(500.0, 0.04), 1.0).max_barrel_displacement
+    assert data["scene"] == f"{model_i().name}, with absorber.mass=500, contact.gap=0.04"
+    assert main(["run", "model_i", "--set", "absorber.mass=500", "--set", "name=light", "--end-time", "1",
+                 "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["scene"] == "light"
+
+
+@pytest.mark.parametrize("command", ["run", "validate"])
+@pytest.mark.parametrize("assignment, needle", [("contact.gap=-1", "contact.gap: must be >= 0 m"),
+                                                ("absorber.mas=1", "did you mean 'mass'"),
+                                                ("contact.gap", "--set: expected KEY=VALUE")])
+def test_bad_set_exits_2(capsys, command, assignment, needle):
+    assert main([command, "model_i", "--set", assignment]) == 2
+    err = capsys.readouterr().err
+    assert needle in err and len(err.strip().splitlines()) == 1
+
+
+def test_a_table_valued_parameter_is_swept_and_resumed(tmp_path, capsys):
+    """``recoil_brake.orifice_area`` as a number or a table of (stroke, area) pairs: a TOML array spec; the
+    column holds each value's TOML text, so the file resumes."""
+    from mbs_models import load_scene
+    from mbs_models.scene.overrides import apply_overrides
+    from mbs_models.scenes import scene_path
+
+    out = tmp_path / "brake.csv"
+    argv = ["sweep", "recoil_brake", "--param", "recoil_brake.orifice_area=[3e-4, [[0.0, 4e-4], [0.2, 2e-4]]]",
+            "--out", str(out), "--end-time", "0.5", "--workers", "1"]
+    assert main(argv) == 0
+    table = pd.read_csv(out)
+    assert table["recoil_brake.orifice_area"].tolist() == ["0.0003", "[[0.0, 0.0004], [0.2, 0.0002]]"]
+    scene = load_scene(scene_path("recoil_brake"))
+    for value, row in zip([3e-4, [[0.0, 4e-4], [0.2, 2e-4]]], table.to_dict("records")):
+        expected = simulate(apply_overrides(scene, {"recoil_brake.orifice_area": value}), 0.5)
+        assert row["max_barrel_displacement"] == expected.max_barrel_displacement
+    assert main(argv) == 0
+    assert "2 points: 0 run, 2 resumed" in capsys.readouterr().out
+
+
+def test_another_end_time_into_the_same_file_exits_2(tmp_path, capsys):
+    out = tmp_path / "s.csv"
+    argv = ["sweep", "model_i", "--param", "contact.gap=0", "--out", str(out), "--workers", "1"]
+    assert main([*argv, "--end-time", "0.2"]) == 0
+    capsys.readouterr()
+    assert main([*argv, "--end-time", "0.3"]) == 2
+    err = capsys.readouterr().err
+    assert "--out:" in err and "another end_time" in err and len(err.strip().splitlines()) == 1

@@ -1,0 +1,54 @@
+"""mbs_models/results/plotting.py: figures in the format the file names; the run plot's panels."""
+
+from __future__ import annotations
+
+import pytest
+
+from mbs_models import SceneError, model_ii, simplified_model, simulate
+from mbs_models.results.plotting import figure_format, new_figure, plot_result, save_figure
+
+
+@pytest.mark.parametrize("name, fmt", [("a.png", "png"), ("a.PDF", "pdf"), ("dir.x/a.svg", "svg")])
+def test_the_extension_names_the_format(name, fmt):
+    assert figure_format(name) == fmt
+
+
+@pytest.mark.parametrize("name", ["a.jpg", "a", "a.png.gz", "a.eps"])
+def test_other_extensions_are_refused_naming_the_key(name):
+    with pytest.raises(SceneError) as error:
+        figure_format(name, key="--plot")
+    assert error.value.key == "--plot" and ".png, .pdf, .svg" in error.value.message
+
+
+@pytest.mark.parametrize("name, magic", [("f.png", b"\x89PNG"), ("f.pdf", b"%PDF-"), ("f.svg", b"<?xml")])
+def test_save_figure_writes_that_format(tmp_path, name, magic):
+    fig, axes = new_figure()
+    axes[0, 0].plot([0, 1], [0, 1])
+    assert save_figure(fig, tmp_path / name).read_bytes().startswith(magic)
+
+
+def test_save_figure_refuses_before_writing(tmp_path):
+    fig, _ = new_figure()
+    with pytest.raises(SceneError):
+        save_figure(fig, tmp_path / "f.jpg")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_the_run_plot_zooms_on_the_first_impact():
+    result = simulate(model_ii(), 1.0, "draft")
+    impact = result.impacts[0]
+    axes = plot_result(result).axes
+    # positions, contact forces, force on the mount, velocities, first impact
+    assert len(axes) == 5
+    zoom = axes[-1]
+    assert zoom.get_xlabel() == "time [ms]" and "first impact" in zoom.get_title()
+    low, high = zoom.get_xlim()
+    assert low < impact.start * 1e3 < impact.end * 1e3 < high < 2 * impact.end * 1e3
+    labels = [line.get_label() for line in zoom.get_lines()]
+    assert "force on the mount" in labels and any("peak" in label for label in labels)
+    assert axes[2].get_ylabel() == "force on the mount [kN]"
+
+
+def test_without_impacts_there_is_no_zoom():
+    axes = plot_result(simulate(simplified_model(), 1.0, "draft")).axes
+    assert len(axes) == 3 and axes[-1].get_xlabel() == "time [s]"

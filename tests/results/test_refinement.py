@@ -1,0 +1,85 @@
+"""Refinement of contact episodes and the support peak in lockstep (mbs_models.results.refinement)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from mbs_models import load_scene, model_ii, simulate
+from mbs_models.engine import simulation
+from mbs_models.results.refinement import refine
+from mbs_models.results.samples import Interpolant
+from mbs_models.engine.mechanism import Mechanism
+from mbs_models.scenes import list_scenes, scene_path
+
+
+def solved(scene, end_time):
+    """The mechanism and samples ``simulate`` hands to the post-processing."""
+    seen = {}
+    original = simulation.analyse
+
+    def spy(mechanism, samples, *args, **kwargs):
+        seen.update(mechanism=mechanism, samples=samples)
+        return original(mechanism, samples, *args, **kwargs)
+
+    simulation.analyse = spy
+    try:
+        simulate(scene, end_time, "standard")
+    finally:
+        simulation.analyse = original
+    return seen["mechanism"], seen["samples"]
+
+
+def one_bracket_crossing(indicator, a, b, points=129, levels=4):
+    """The scalar search the post-processing ran before issue #11 (the reference)."""
+    for _ in range(levels):
+        grid = np.linspace(a, b, points)
+        flags = np.asarray(indicator(grid), dtype=bool)
+        flags[-1] = True
+        j = int(np.argmax(flags[1:])) + 1
+        a, b = grid[j - 1], grid[j]
+    return float(0.5 * (a + b))
+
+
+def test_an_episode_lifted_over_the_threshold_by_its_refined_peak_gets_refined_bounds():
+    """Its bounds are searched after the peaks (the second round): the same bits as when its samples
+    alone make it an impact, and as the one-bracket search."""
+    mechanism, s = solved(model_ii(1000.0, 0.0), 2.0)
+    interp = Interpolant(s)
+    contact = mechanism.contacts[0]
+    force = s.forces[contact.name]
+    every = refine(mechanism, s.time, s.forces, interp, [contact], 0.0)[0][contact.name]  # all surely impacts
+    lifted = np.flatnonzero((every.peak_force > force[every.k]) & (every.first > 0) & (every.last < len(s.time) - 1))
+    assert len(lifted)
+    e = int(lifted[0])
+    threshold = 0.5 * (force[every.k[e]] + every.peak_force[e])  # above the samples, below the refined peak
+    late = refine(mechanism, s.time, s.forces, interp, [contact], threshold)[0][contact.name]
+    assert late.peak_force[e] > threshold >= force[late.first[e]:late.last[e] + 1].max()
+    assert (late.start[e], late.end[e]) == (every.start[e], every.end[e])
+    assert late.start[e] < s.time[late.first[e]] and late.end[e] > s.time[late.last[e]]
+
+    def positive(t):
+        d = mechanism.relative(contact, {n: interp.x[n](t) for n in interp.names})
+        rate = mechanism.relative(contact, {n: interp.v[n](t) for n in interp.names})
+        return contact.force(d, rate, t) > 0.0
+
+    t, i0, i1 = s.time, late.first[e], late.last[e]
+    assert late.start[e] == one_bracket_crossing(positive, t[i0 - 1], t[i0])
+    assert late.end[e] == one_bracket_crossing(lambda x: ~positive(x), t[i1], t[i1 + 1])
+
+
+#: The shipped scenes with several contacts (absorbers or end stops).
+SEVERAL_CONTACTS = [name for name in list_scenes() if len(Mechanism(load_scene(scene_path(name))).contacts) > 1]
+
+
+@pytest.mark.parametrize("name", SEVERAL_CONTACTS)
+def test_contacts_together_equal_contacts_alone(name):
+    """Several contacts and the support peak share the rounds; each gets what it gets alone."""
+    mechanism, s = solved(load_scene(scene_path(name)), 3.0)
+    interp = Interpolant(s)
+    together, support = refine(mechanism, s.time, s.forces, interp, mechanism.contacts, 1000.0, 10)
+    assert support == refine(mechanism, s.time, s.forces, interp, [], 1000.0, 10)[1]
+    for contact in mechanism.contacts:
+        alone = refine(mechanism, s.time, s.forces, interp, [contact], 1000.0)[0][contact.name]
+        for field in ("first", "last", "k", "peak_force", "time_of_peak_force", "start", "end"):
+            assert np.array_equal(getattr(together[contact.name], field), getattr(alone, field)), (contact.name, field)

@@ -1,0 +1,38 @@
+"""mbs_models/results/result.py: the end of the window and the summary's header."""
+
+from __future__ import annotations
+
+from mbs_models import model_ii, simplified_model, simulate
+
+
+def test_a_maximum_still_rising_at_the_end_of_the_window_is_flagged():
+    short = simulate(simplified_model(), 0.05, "draft")
+    assert short.barrel_velocity[-1] > 0 and short.time_of_max_barrel_displacement == short.time[-1]
+    assert short.max_at_end_of_window is True
+    assert short.maxima_at_end_of_window()[0] == "max_barrel_displacement"
+    assert short.metrics()["max_at_end_of_window"] is True
+    assert "not a turning point" in short.summary()
+
+
+def test_a_turning_point_is_not_flagged():
+    full = simulate(simplified_model(), 2.0, "draft")
+    assert full.time_of_max_barrel_displacement < full.time[-1]
+    assert full.max_at_end_of_window is False and full.maxima_at_end_of_window() == []
+    assert "turning point" not in full.summary()
+
+
+def test_an_unproven_maximum_has_no_flag():
+    """Stopped at 0.45 s once the absorber's velocity is final: the barrel still moves out, and its maximum is
+    None (not proven), not a value "at the end of the window"."""
+    early = simulate(model_ii(1000.0, 0.0), 10.0, stop_when_final=("max_absorber_velocity",))
+    assert early.max_barrel_displacement is None and early.barrel_velocity[-1] > 0
+    assert early.max_at_end_of_window is None and "max_barrel_displacement" not in early.maxima_at_end_of_window()
+    proven = simulate(model_ii(1000.0, 0.0), 10.0, stop_when_final=("peak_contact_force",))
+    assert proven.max_barrel_displacement is not None and proven.max_at_end_of_window is False
+
+
+def test_the_header_names_the_model_once_and_adds_it_where_the_name_lacks_it():
+    scene = model_ii()
+    assert simulate(scene, 0.05, "draft").summary().splitlines()[0].count("model (ii)") == 1
+    renamed = scene.with_changes(name="my mechanism")
+    assert simulate(renamed, 0.05, "draft").summary().splitlines()[0].startswith("my mechanism (model (ii)), ")

@@ -1,0 +1,86 @@
+"""One sweep point as a row (mbs_models.studies.point): the numbers of a single simulate run, failures kept."""
+
+from __future__ import annotations
+
+import pytest
+
+from mbs_models import Conventions, load_scene, model_i, model_ii, simulate
+from mbs_models.scenes import scene_path
+from mbs_models.studies.point import PointSettings, evaluate_batch, evaluate_point, metric_columns
+
+SETTINGS = PointSettings(end_time=1.0)
+
+
+def test_row_equals_a_single_simulate_run():
+    row = evaluate_point(model_ii(500.0, 0.0), {"absorber.mass": 1000.0, "contact.gap": 0.04}, SETTINGS)
+    result = simulate(model_ii(1000.0, 0.04), 1.0)
+    assert row["absorber.mass"] == 1000.0 and row["contact.gap"] == 0.04
+    for name in ("max_barrel_displacement", "time_of_max_barrel_displacement", "peak_support_force",
+                 "time_of_peak_support_force", "peak_contact_force", "time_of_peak_contact_force",
+                 "max_absorber_velocity", "time_of_max_absorber_velocity"):
+        assert row[name] == getattr(result, name), name
+    assert row["impacts"] == len(result.impacts)
+    assert row["end_time"] == result.end_time and row["steps"] == result.steps
+    assert row["initial_velocity"] == result.scene.initial_velocity
+    assert row["status"] == "ok" and row["error"] is None and row["wall_time"] > 0
+    assert list(row) == ["absorber.mass", "contact.gap", *metric_columns(model_ii()), "wall_time", "status", "error"]
+
+
+def test_per_absorber_columns():
+    scene = load_scene(scene_path("two_absorbers"))
+    row = evaluate_point(scene, {"absorber.1.contact.gap": 0.01}, SETTINGS)
+    result = simulate(scene.with_changes(**{"absorber.1.contact.gap": 0.01}), 1.0)
+    for i, entry in enumerate(result.absorbers()):
+        assert row[f"absorber.{i}.peak_contact_force"] == entry["peak_contact_force"]
+        assert row[f"absorber.{i}.max_absorber_velocity"] == entry["max_absorber_velocity"]
+        assert row[f"absorber.{i}.impacts"] == len(entry["impacts"])
+
+
+def test_per_stop_columns(every_element):
+    scene = every_element()
+    row = evaluate_point(scene, {}, PointSettings(end_time=0.5))
+    result = simulate(scene, 0.5)
+    assert result.stops() and row["status"] == "ok"
+    for entry in result.stops():
+        assert row[f"{entry['element']}.peak_contact_force"] == entry["peak_contact_force"]
+        assert row[f"{entry['element']}.impacts"] == len(entry["impacts"])
+        assert row[f"{entry['element']}.dissipated_energy"] == entry["dissipated_energy"]
+
+
+
+def test_a_scene_with_one_absorber_has_no_per_absorber_columns():
+    assert "absorber.0.impacts" not in metric_columns(model_i())
+
+
+def test_a_failed_solve_is_a_row_with_its_error():
+    row = evaluate_point(model_ii(1000.0, 0.0), {"conventions.compression_only": True}, PointSettings(end_time=0.5))
+    assert row["status"] == "SimulationError" and "step budget" in row["error"]
+    assert row["max_barrel_displacement"] is None and row["conventions.compression_only"] is True
+
+
+def test_an_invalid_combination_is_a_row_with_its_error():
+    row = evaluate_point(model_i(), {"contact.law": "hunt-crossley", "contact.restitution": 0.5}, SETTINGS)
+    assert row["status"] == "SceneError"
+    assert row["error"].startswith("contact.restitution: not a field of law 'hunt-crossley'")
+
+
+def test_a_batch_keeps_the_indices():
+    out = evaluate_batch((model_i(), SETTINGS, [(7, {"contact.gap": 0.0}), (3, {"contact.gap": -1.0})]))
+    assert [index for index, _ in out] == [7, 3]
+    assert [row["status"] for _, row in out] == ["ok", "SceneError"]
+
+
+def test_other_exceptions_are_bugs_and_propagate(monkeypatch):
+    import mbs_models.studies.point as point
+
+    def broken(scene, settings):
+        raise ZeroDivisionError("a bug")
+
+    monkeypatch.setattr(point, "simulate_scene", broken)
+    with pytest.raises(ZeroDivisionError):
+        evaluate_point(model_i(), {"contact.gap": 0.0}, SETTINGS)
+
+
+def test_conventions_reach_the_row():
+    row = evaluate_point(model_i(), {"conventions.v0_includes_absorber": True}, SETTINGS)
+    assert row["initial_velocity"] == model_i(conventions=Conventions(v0_includes_absorber=True)).initial_velocity
