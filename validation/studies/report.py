@@ -38,6 +38,7 @@ from .claims import ClaimEvidence, evaluate_claims
 from .compare import compare
 from .conventions import CONVENTION_CASES, TREND_GAPS, study_conventions
 from .paper import MODEL_I, MODEL_II, SIMPLIFIED, TABLE2_MASSES, published, published_values, table2
+from .provenance import FIELDS as PROVENANCE_FIELDS, provenance
 
 Progress = Callable[[str], None]
 #: A published number counts as reproduced when ours is within this relative difference.
@@ -506,6 +507,9 @@ pre.wrap{white-space:pre-wrap;overflow-wrap:anywhere}
 figure{margin:1.2em 0}figure img{max-width:100%;border:1px solid #eee}figcaption{font-size:.9em;color:#555}
 .bad{color:#b00020;font-weight:600}.good{color:#1b7f2a;font-weight:600}.bad,.good{white-space:nowrap}
 .note{background:#fff8e1;padding:.6em 1em;border-left:4px solid #f0c000}
+dl.meta{display:grid;grid-template-columns:max-content 1fr;gap:.15em 1em;font-size:.92em;margin:1em 0}
+dl.meta dt{font-weight:600;color:#555}dl.meta dd{margin:0;overflow-wrap:anywhere}
+#summary{font-size:1.05em;background:#f3f7fb;padding:.7em 1em;border-left:4px solid #4a7fb5}
 @media print{pre{white-space:pre-wrap;overflow-wrap:anywhere}.scroll{overflow:visible}}
 """
 
@@ -593,12 +597,78 @@ def _contents(sections: list[tuple[str, str]]) -> str:
     return f"<nav id='contents' aria-label='Contents'><p><b>Contents</b></p><ol>{items}</ol></nav>"
 
 
+def _provenance_html(fields: dict[str, str]) -> str:
+    """The header: the paper replicated, when and with what the report was made."""
+    items = "".join(f"<dt>{_e(label)}</dt><dd>{'<i>' if key == 'paper' else ''}{_e(fields.get(key, 'unknown'))}"
+                    f"{'</i>' if key == 'paper' else ''}</dd>" for key, label in PROVENANCE_FIELDS)
+    return f"<dl id='provenance' class='meta'>{items}</dl>"
+
+
+def _count(n: int, total: int) -> str:
+    return f"{n} of {total}"
+
+
+def verdict(data: dict) -> str:
+    """The report's verdict in one paragraph of plain text: what is reproduced, what is not, how well the
+    engine agrees with the independent reference."""
+    t2, s22 = table2_rows(data), section22_rows(data)
+    ok = lambda rows: sum(abs(r["relative_difference"]) <= REPRODUCED_WITHIN for r in rows)  # noqa: E731
+    comparisons = data["comparisons"]
+    passed = sum(c["passed"] for c in comparisons)
+    worst = max((x["relative_error"] for c in comparisons for x in c["checks"]
+                 if x.get("relative_error") is not None), default=None)
+    claims = [v for v in data.get("claims", []) if v.holds is not None]
+    text = (f"{_count(ok(t2), len(t2))} maximum barrel displacements of Table 2"
+            + (f" and {_count(ok(s22), len(s22))} first-impact numbers of Section 2.2" if s22 else "")
+            + f" are reproduced within {REPRODUCED_WITHIN * 100:g} % of the published values")
+    if claims:
+        text += f"; {sum(v.holds for v in claims)} of the paper's {len(claims)} qualitative claims hold"
+    text += (f". The engine agrees with the independent reference in {_count(passed, len(comparisons))} cases"
+             + (f" (largest relative error {worst:.1e})" if worst is not None else "") + ".")
+    missed = [r for r in t2 if abs(r["relative_difference"]) > REPRODUCED_WITHIN]
+    if missed:
+        text += (" Not reproduced in Table 2: "
+                 + ", ".join(f"{r['model']} at m = {r['absorber_mass']:g} kg ({percent_text(r['relative_difference'])})"
+                             for r in missed) + ".")
+    missed22 = [r for r in s22 if abs(r["relative_difference"]) > REPRODUCED_WITHIN]
+    if missed22:
+        largest = max(missed22, key=lambda r: abs(r["relative_difference"]))
+        text += (f" Not reproduced in Section 2.2: {_count(len(missed22), len(s22))} numbers, by up to "
+                 f"{percent_text(largest['relative_difference'])}.")
+    failed = [v for v in claims if not v.holds]
+    if failed:
+        text += f" {len(failed)} of the claims do not hold."
+    return text
+
+
+def percent_text(fraction: float, digits: int = 1) -> str:
+    """A signed relative difference in %, with enough decimals not to print a non-zero one as "-0.0 %"
+    (a non-breaking space before the % sign, which never wraps onto its own line)."""
+    value = fraction * 100
+    if value == 0:
+        return "0\u00a0%"
+    while digits < 4 and round(abs(value), digits) == 0:
+        digits += 1
+    if round(abs(value), digits) == 0:
+        return f"{'-' if value < 0 else '+'}less than 0.001\u00a0%"
+    return f"{value:+.{digits}f}\u00a0%"
+
+
+_COLOUR_RULE = (f"<p class='note' id='colour-rule'>Colours: <span class='good'>green</span> marks a number within "
+                f"{REPRODUCED_WITHIN * 100:g} % of the published value, or a check that passes; "
+                "<span class='bad'>red</span> one further off, or a check that fails.</p>")
+
+
 def render_html(data: dict, pngs: dict[str, bytes]) -> str:
     """The report as one self-contained HTML page."""
     parts = ["<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
              "<meta name='viewport' content='width=device-width, initial-scale=1'>"
              f"<title>Recoil absorber replication report</title><style>{_CSS}</style></head><body>",
              "<h1>Replication report: recoil mechanism with impact absorbers</h1>",
+             _provenance_html(data.get("provenance") or provenance()),
+             f"<p id='summary'><b>Verdict.</b> {_e(verdict(data))}"
+             + (" Each number not reproduced is listed with its most likely reason under <a href='#unreproduced'>"
+                "Published numbers we cannot reproduce</a>." if data.get("unreproduced") else "") + "</p>",
              "<p>Engine: Exudyn (symbolic user functions, accuracy preset "
              f"<code>{_e(data['options']['accuracy'])}</code>). Independent check: an event-driven scipy solution of "
              "the same equations (<code>validation.reference</code>). Nothing is tuned to the published numbers; where "
@@ -626,6 +696,7 @@ def render_html(data: dict, pngs: dict[str, bytes]) -> str:
     # table 2
     t2 = table2_rows(data)
     parts.append(section("table2", "Table 2: maximum barrel displacement and force on the mount (gap 0, 10 s)"))
+    parts.append(_COLOUR_RULE)          # the first table with coloured numbers follows
     parts.append(_table(["model", "m [kg]", "ours [m]", "peak support force [kN]", "reference [m]", "paper [m]",
                          "ours - paper [mm]", "relative", "engine vs reference"],
                         [[_e(r["model"]), f"{r['absorber_mass']:g}", f"{r['engine']:.5f}", _kn(r["peak_support_force"]),
@@ -780,6 +851,7 @@ def results_json(data: dict) -> dict:
         "unreproduced": data["unreproduced"],
         "timings": data["timings"],
         "machine": data.get("machine"),
+        "provenance": data.get("provenance"),
     })
 
 
@@ -802,6 +874,7 @@ def write_report(out: str | Path, options: ReportOptions = ReportOptions(), prog
                       + "".join(f"- {sentence}\n" for sentence in mount_force_sentences(rows)))
     atomic_write_json(out / "table2.json", {"rows": rows, "units": TABLE2_UNITS})
     data["timings"]["total"] = time.perf_counter() - start
+    data["provenance"] = provenance()
     atomic_write_json(out / "results.json", results_json(data))
     atomic_write_text(out / "report.html", render_html(data, pngs))
     return data

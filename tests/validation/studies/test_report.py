@@ -25,6 +25,15 @@ from validation.studies.report import ReportOptions, _sketch, write_report
 DRAWING = set("|/\\-=+[]<>")
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 SUPPORT_FORCE_HEADER = "peak support force [kN]"
+#: The header's fields (label -> what its text must look like): the paper's title, when and with what.
+HEADER_FIELDS = {
+    "Paper replicated": r"analysis of a dynamic system subjected to an impulsive and internal contact force",
+    "Made on": r"\d{4}-\d\d-\d\d \d\d:\d\d( UTC)?",
+    "Package": r"recoil-mbs \d+\.\d+\.\d+\S*",
+    "Commit": r"([0-9a-f]{40}( \(uncommitted changes\))?|unknown)",
+    "Exudyn": r"(\d+\.\d+\S*|unknown)", "numpy": r"(\d+\.\d+\S*|unknown)", "scipy": r"(\d+\.\d+\S*|unknown)",
+    "Machine": r".+, \d+ CPUs",
+}
 
 
 class _Page(HTMLParser):
@@ -40,6 +49,11 @@ class _Page(HTMLParser):
         self.images: list[str] = []
         self.tables: list[dict] = []                 # {"section", "headers", "rows"}
         self.text: list[str] = []                    # visible text and attribute values but image data
+        self.viewport: str | None = None             # content of <meta name="viewport">
+        self.header: dict[str, str] = {}             # the provenance header: <dt> label -> <dd> text
+        self.order: list[str] = []                   # ids of the summary, contents and sections, in order
+        self._dt: str | None = None
+        self._field: list[str] | None = None
         self._section: str | None = None
         self._after_h3 = False
         self._pre: dict | None = None
@@ -52,6 +66,11 @@ class _Page(HTMLParser):
         self.text += [str(v) for k, v in attrs.items() if k != "src" and v]
         if "id" in attrs:
             self.ids.append(attrs["id"])
+            self.order.append(attrs["id"])
+        if tag == "meta" and attrs.get("name") == "viewport":
+            self.viewport = attrs.get("content", "")
+        if tag in ("dt", "dd"):
+            self._field = []
         if tag == "h2":
             self._section = attrs.get("id")
             self.sections.append(self._section)
@@ -76,6 +95,13 @@ class _Page(HTMLParser):
             self._after_h3 = False          # a sketch is the box right after a model's <h3>
 
     def handle_endtag(self, tag):
+        if tag in ("dt", "dd") and self._field is not None:
+            text = "".join(self._field).strip()
+            if tag == "dt":
+                self._dt = text
+            elif self._dt is not None:
+                self.header[self._dt] = text
+            self._field = None
         if tag == "h3":
             self._after_h3 = True
         if tag == "pre" and self._pre is not None:
@@ -96,6 +122,8 @@ class _Page(HTMLParser):
 
     def handle_data(self, data):
         self.text.append(data)
+        if self._field is not None:
+            self._field.append(data)
         if self._pre is not None:
             self._pre["text"] += data
         if self._cell is not None:
@@ -147,6 +175,21 @@ def page_problems(html_text: str) -> list[str]:
         size = _png_size(png)
         if size is None or min(size) <= 0:
             problems.append(f"image {number} is not a PNG with a size: {src[:40]!r}")
+    # a phone shows the page at its own width
+    if page.viewport is None or "width=device-width" not in page.viewport:
+        problems.append(f"no viewport meta with width=device-width: {page.viewport!r}")
+    # the header: which paper, when, with what
+    for label, pattern in HEADER_FIELDS.items():
+        if not re.fullmatch(pattern, page.header.get(label, ""), re.IGNORECASE):
+            problems.append(f"header field {label!r} is {page.header.get(label)!r}, expected {pattern!r}")
+    # the verdict comes first, before the table of contents and every section
+    if "summary" not in page.order:
+        problems.append("no summary with the verdict (id 'summary')")
+    elif page.order.index("summary") > min((page.order.index(i) for i in ["contents", *page.sections]
+                                            if i in page.order), default=len(page.order)):
+        problems.append("the summary comes after the table of contents or a section")
+    elif "Verdict" not in "".join(page.text):
+        problems.append("the summary gives no verdict")
     # no reference to a document the reader does not have
     if any("DESIGN.md" in text for text in page.text):
         problems.append("the page cites DESIGN.md")
@@ -365,8 +408,14 @@ def _tiny_png(width: int = 2, height: int = 1) -> bytes:
 
 
 _SKETCH = "    k\n|--/\\/\\--+-----+\n|        |  M  |\n|--[ c ]-+-----+\nground"
+_HEADER = ("<dl id='provenance'><dt>Paper replicated</dt><dd><i>Analysis of a dynamic system subjected to an "
+           "impulsive and internal contact force</i></dd><dt>Made on</dt><dd>2026-01-02 03:04 UTC</dd>"
+           "<dt>Package</dt><dd>recoil-mbs 0.1.0</dd><dt>Commit</dt><dd>unknown</dd><dt>Exudyn</dt><dd>1.13.6</dd>"
+           "<dt>numpy</dt><dd>2.4.6</dd><dt>scipy</dt><dd>1.17.1</dd><dt>Machine</dt><dd>Linux, x86_64, 2 CPUs</dd>"
+           "</dl><p id='summary'><b>Verdict.</b> all reproduced</p>")
 _GOOD_PAGE = (
-    "<html><body><h1>Report</h1><p>intro</p>"
+    "<html><head><meta name='viewport' content='width=device-width, initial-scale=1'></head><body><h1>Report</h1>"
+    + _HEADER + "<p>intro</p>"
     "<nav id='contents'><ol><li><a href='#models'>Models</a></li><li><a href='#table2'>Table 2</a></li></ol></nav>"
     "<h2 id='models'>1. Models and equations</h2>"
     + "".join(f"<h3>Model {n}</h3><pre>{_SKETCH}</pre>" for n in (1, 2, 3))
@@ -398,9 +447,40 @@ def test_page_checker_passes_a_sound_page():
      "not a PNG"),
     (_GOOD_PAGE.replace("data:image/png;base64,", "tiny.png?"), "not a PNG"),
     (_GOOD_PAGE.replace("<p>intro</p>", "<p>see DESIGN.md</p>"), "DESIGN.md"),
+    (_GOOD_PAGE.replace("<meta name='viewport' content='width=device-width, initial-scale=1'>", ""), "viewport"),
+    (_GOOD_PAGE.replace("<dd>1.17.1</dd>", "<dd></dd>"), "header field 'scipy'"),
+    (_GOOD_PAGE.replace("<dt>Commit</dt><dd>unknown</dd>", ""), "header field 'Commit'"),
+    (_GOOD_PAGE.replace("<dd>unknown</dd>", "<dd>HEAD</dd>"), "header field 'Commit'"),
+    (_GOOD_PAGE.replace("impulsive and internal", "impulsive"), "header field 'Paper replicated'"),
+    (_GOOD_PAGE.replace("<p id='summary'><b>Verdict.</b> all reproduced</p>", ""), "no summary"),
+    (_GOOD_PAGE.replace("<p id='summary'><b>Verdict.</b> all reproduced</p>", "").replace(
+        "<h2 id='table2'>", "<p id='summary'><b>Verdict.</b> all</p><h2 id='table2'>"), "summary comes after"),
     (_GOOD_PAGE.replace("<th>peak support force [kN]</th>", "<th>peak support force [N]</th>"), "column"),
     (_GOOD_PAGE.replace("<td>6.89</td>", "<td>&ndash;</td>"), "no positive support force"),
 ])
 def test_page_checker_finds_each_defect(broken, expected):
     problems = page_problems(broken)
     assert any(expected in problem for problem in problems), problems
+
+
+# ------------------------------------------------------------------------------------- percentages
+@pytest.mark.parametrize("fraction, expected", [
+    (-0.0002, "-0.02\u00a0%"), (0.0177, "+1.8\u00a0%"), (-0.25306, "-25.3\u00a0%"), (0.0, "0\u00a0%"),
+    (3e-6, "+0.0003\u00a0%"), (-1e-9, "-less than 0.001\u00a0%"),
+])
+def test_percent_text_never_rounds_a_difference_to_zero(fraction, expected):
+    from validation.studies.report import percent_text
+    assert percent_text(fraction) == expected
+
+
+def test_the_verdict_counts_what_table2_shows(report_dir):
+    text = (report_dir / "report.html").read_text()
+    summary = html.unescape(re.search(r"<p id='summary'>(.*?)</p>", text, re.DOTALL).group(1))
+    page = _Page()
+    page.feed(text)
+    table2 = next(t for t in page.tables if t["section"] == "table2")
+    relative = table2["headers"].index("relative")
+    within = [abs(float(row[relative].replace("\u00a0", " ").split()[0])) <= 1.0 for row in table2["rows"]]
+    assert f"{sum(within)} of {len(within)} maximum barrel displacements of Table 2" in summary, summary
+    comparisons = json.loads((report_dir / "results.json").read_text())["engine_vs_reference"]
+    assert f"in {sum(c['passed'] for c in comparisons)} of {len(comparisons)} cases" in summary, summary
