@@ -39,6 +39,7 @@ from .claims import ClaimEvidence, evaluate_claims
 from .compare import compare
 from .conventions import CONVENTION_CASES, TREND_GAPS, study_conventions
 from .paper import MODEL_I, MODEL_II, SIMPLIFIED, TABLE2_MASSES, published, published_values, table2
+from .progress import counter
 from .provenance import FIELDS as PROVENANCE_FIELDS, provenance
 
 Progress = Callable[[str], None]
@@ -107,11 +108,8 @@ def _comparison_scenes(options: ReportOptions) -> list[Scene]:
 
 
 def _counter(progress: Progress, label: str):
-    """A (done, total) progress callback that reports roughly every quarter."""
-    def report(done: int, total: int) -> None:
-        if done == total or done % max(1, total // 4) == 0:
-            progress(f"  {label}: {done}/{total}")
-    return report
+    """A (done, total) progress callback: a tqdm bar from the command line, else a line about every quarter."""
+    return counter(progress, label)
 
 
 def compute_report(options: ReportOptions = ReportOptions(), progress: Progress = _silent) -> dict:
@@ -127,7 +125,8 @@ def compute_report(options: ReportOptions = ReportOptions(), progress: Progress 
     scenes = _comparison_scenes(options)
     if options.comparison_gaps == (0.0, 0.04, 0.08) and options.masses == TABLE2_MASSES:
         assert len(scenes) == 19
-    outputs = parallel_map(_comparison_job, scenes, workers=options.workers, progress=_counter(progress, "cases"))
+    outputs = parallel_map(_comparison_job, scenes, workers=options.workers,
+                           progress=_counter(progress, "engine vs reference"))
     data["comparisons"] = [case for case, _ in outputs]
     timings["engine vs reference"] = time.perf_counter() - start
 
@@ -155,7 +154,7 @@ def compute_report(options: ReportOptions = ReportOptions(), progress: Progress 
     progress(f"gap sweeps: {len(gaps)} gaps x {len(options.masses)} masses x 2 models")
     sweep_scenes = [factory(m, float(g)) for factory in (model_i, model_ii) for m in options.masses for g in gaps]
     points = run_sweep(sweep_scenes, options.end_time, options.accuracy, workers=options.workers,
-                       progress=_counter(progress, "runs"), stop_when_final=("max_barrel_displacement",))
+                       progress=_counter(progress, "gap sweeps"), stop_when_final=("max_barrel_displacement",))
     sweeps: dict[tuple[str, float], list[tuple[float, float]]] = {}
     failures = []
     for point in points:
@@ -173,7 +172,7 @@ def compute_report(options: ReportOptions = ReportOptions(), progress: Progress 
         progress("convention study")
         cases = [c for c in CONVENTION_CASES if options.convention_labels is None or c[0] in options.convention_labels]
         data["conventions"] = study_conventions(tuple(cases), workers=options.workers,
-                                                progress=_counter(progress, "runs"))
+                                                progress=_counter(progress, "convention study"))
         timings["convention study"] = time.perf_counter() - start
 
         start = time.perf_counter()
