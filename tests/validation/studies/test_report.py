@@ -636,3 +636,38 @@ def test_report_has_the_energy_figure(report_dir):
     page.feed((report_dir / "report.html").read_text())
     assert "fig-energy_m1000" in page.ids and "energy" in page.ids
     assert (report_dir / "energy_m1000.png").read_bytes()[:8] == PNG_SIGNATURE
+
+
+def test_the_page_shows_mm_and_kn_while_the_files_stay_si(report_dir):
+    """Display units are the page's only: table2.json and results.json keep metres and newtons."""
+    table = json.loads((report_dir / "table2.json").read_text())
+    results = json.loads((report_dir / "results.json").read_text())
+    assert table["units"]["engine"] == "m" and table["units"]["peak_support_force"] == "N"
+    assert results["table2"] == table["rows"]
+    for row in table["rows"]:
+        assert 0.1 < row["engine"] < 0.3 and 0.1 < row["paper"] < 0.3          # metres, not millimetres
+        assert 1e3 < row["peak_support_force"] < 1e5                            # newtons, not kilonewtons
+    page = _Page()
+    page.feed((report_dir / "report.html").read_text())
+    shown = next(t for t in page.tables if t["section"] == "table2")
+    ours, force = shown["headers"].index("ours [mm]"), shown["headers"].index(SUPPORT_FORCE_HEADER)
+    for row, cells in zip(table["rows"], shown["rows"]):
+        assert float(cells[ours]) == pytest.approx(row["engine"] * 1e3, abs=0.006)
+        assert float(cells[force]) == pytest.approx(row["peak_support_force"] / 1e3, abs=0.006)
+    for item in results["unreproduced"]:
+        assert item["unit"] in ("m", "N", "m/s", "s", ""), item["unit"]
+
+
+def test_every_image_of_the_page_decodes_to_its_stated_size(report_dir):
+    import io
+
+    import matplotlib.image
+
+    page = _Page()
+    page.feed((report_dir / "report.html").read_text())
+    assert page.images
+    for src in page.images:
+        png = base64.b64decode(src.split(",", 1)[1], validate=True)
+        width, height = _png_size(png)
+        pixels = matplotlib.image.imread(io.BytesIO(png), format="png")
+        assert pixels.shape[:2] == (height, width) and pixels.shape[0] > 100 and pixels.shape[1] > 100
