@@ -1,12 +1,17 @@
 """The replication report: ``recoil paper --out DIR`` writes ``report.html`` and ``results.json``.
 
 One self-contained HTML file (figures embedded as PNG data) for a reviewer of the replication:
-the models and their equations, parameters, Table 2 (ours, paper, difference), the gap sweeps
-(Figs 4-5), time histories (Figs 6-8), contact force and absorber velocity (Figs 9-11),
+a header (the paper replicated; date, package version and commit, libraries, machine), the verdict
+in one paragraph, the table of contents, the models and their equations, parameters, Table 2
+(ours, paper, difference), the gap sweeps (Figs 4-5), time histories (Figs 6-8) and the energy
+of each element (m = 1000 kg), contact force and absorber velocity (Figs 9-11),
 engine-vs-reference errors for every case shown, the convention study, the contact-law
 calibration, the paper's qualitative claims checked, and a plain list of every published number we
 cannot reproduce with its most likely reason.  PNG files, ``table2.md`` and ``table2.json`` are
 written beside it.  Everything is written under a temporary name and renamed.
+
+The page shows displacements in mm and forces in kN (:data:`DISPLAY_UNITS`); ``results.json`` and
+``table2.json`` stay in SI units.
 """
 
 from __future__ import annotations
@@ -584,7 +589,8 @@ def unreproduced(data: dict) -> list[dict]:
         calibrated = calibration_rows.get(key)
         reason, explained = best_reading(lambda c: c.table2_errors()[key])
         if calibrated:
-            reason.append(f"The contact law calibrated on Section 2.2 gives {percent_text(calibrated['relative_error'])}")
+            reason.append("The contact law calibrated on Section 2.2 gives "
+                          + percent_text(calibrated["relative_error"]))
         if row["model"] == MODEL_II and row["paper"] == table2()[(SIMPLIFIED, row["absorber_mass"])].value:
             reason.append("The published value equals the simplified model's exactly, as if the absorber were never "
                           "hit, which gap 0 cannot give; the paper's own Fig. 6 sentence says model (ii) is lower. "
@@ -604,7 +610,8 @@ def unreproduced(data: dict) -> list[dict]:
             fitted = next((r for r in calibration.residuals if r.get("quantity") == row["quantity"]
                            and row["model"] + ":" in r.get("description", "")), None)
             if fitted is not None and fitted.get("relative_error") is not None:
-                reason.append(f"A contact law fitted to Section 2.2 ({_law_text(calibration.parameters, calibration.fixed)}) "
+                law = _law_text(calibration.parameters, calibration.fixed)
+                reason.append(f"A contact law fitted to Section 2.2 ({law}) "
                               f"reproduces it to {percent_text(fitted['relative_error'], 2)}, so the published impact "
                               "numbers most likely come from other contact parameters than Table 1's")
         items.append(item(f"Section 2.2, {row['model']}, {row['quantity'].replace('_', ' ')}", row["paper"],
@@ -617,7 +624,8 @@ def unreproduced(data: dict) -> list[dict]:
                 literal = trend.get("literal_gap_sign")
                 if literal:
                     reason.append("Only the reading with the gap's sign as printed in Eq. (6), where the gap acts "
-                                  f"as an interference, makes the displacement fall with the gap ({', '.join(f'{x * 1e3:.1f}' for x in literal)}\u00a0mm at gaps "
+                                  "as an interference, makes the displacement fall with the gap "
+                                  f"({', '.join(f'{x * 1e3:.1f}' for x in literal)}\u00a0mm at gaps "
                                   f"{', '.join(f'{g * 1e3:g}' for g in TREND_GAPS)}\u00a0mm), as Fig. 5 claims")
             items.append(item(f"Claim of {verdict.claim.source}: \u201c{verdict.claim.text}\u201d", None, None, "",
                               None, reason))
@@ -940,7 +948,8 @@ def render_html(data: dict, pngs: dict[str, bytes]) -> str:
     parts.append(section("contact", "Contact force and absorber velocity (Figs 9-11)"))
     s22 = section22_rows(data)
     parts.append(_table(["model", "quantity", "ours", "paper", "unit", "relative", "source"],
-                        [[_e(r["model"]), _e(r["quantity"].replace("_", " ")), _fmt(display(r["ours"], r["unit"])[0], 5),
+                        [[_e(r["model"]), _e(r["quantity"].replace("_", " ")),
+                          _fmt(display(r["ours"], r["unit"])[0], 5),
                           _fmt(display(r["paper"], r["unit"])[0], 5), _e(display(r["paper"], r["unit"])[1]),
                           _pct(r["relative_difference"]), _e(r["source"])] for r in s22], table_id="tab-section22"))
     for mass in data["options"]["masses"]:
@@ -998,7 +1007,8 @@ def render_html(data: dict, pngs: dict[str, bytes]) -> str:
         parts.append(_img("conventions_gap_trend", pngs["conventions_gap_trend"],
                           "Model (ii), m = 1000 kg: maximum barrel displacement vs gap under each reading"
                           + "".join(f"; the line of '{reading_short(a)}' coincides with that of '{reading_short(b)}' "
-                                    "(drawn dashed with hollow markers over it): that reading does not change model (ii)"
+                                    "(drawn dashed with hollow markers over it): that reading does not change "
+                                    "model (ii)"
                                     for a, b in same.items())))
     else:
         parts.append(not_run)
