@@ -342,7 +342,7 @@ def _energy_figure(data: dict, mass: float):
     """Where the firing's energy goes: kinetic, stored and dissipated energy of each element vs time, models
     (i) and (ii), gap 0; the sum of them all is the initial kinetic energy of the barrel (up to the error)."""
     runs = [data["runs"][(MODEL_I, mass)], data["runs"][(MODEL_II, mass)]]
-    fig, axes = new_figure(2, 1, row_height=3.3, sharex=True)
+    fig, axes = new_figure(2, 1, width=10.0, row_height=3.3, sharex=True)
     names = sorted({name for run in runs for _, name, _ in energy_histories(run)})
     colours = {name: _ENERGY_COLOURS[i % len(_ENERGY_COLOURS)] for i, name in enumerate(names)}
     for ax, run in zip(axes[:, 0], runs):
@@ -354,7 +354,7 @@ def _energy_figure(data: dict, mass: float):
         ax.plot(run.time, total, color="k", lw=0.8, ls=":", label=f"sum ({total[0]:.0f} J at t = 0)")
         ax.set_ylabel("energy [J]")
         ax.set_title(f"{run.scene.model_label}, m = {mass:g} kg, gap 0", fontsize=10)
-        ax.legend(fontsize=7.5, ncol=2, loc="center right")
+        ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))   # beside the curves, never on them
     axes[-1, 0].set_xlabel("time [s]")
     fig.suptitle("Energy per element: kinetic (solid), stored (dashed), dissipated (dash-dot)", fontsize=11)
     return fig
