@@ -17,7 +17,9 @@ Contract
   limit); an adaptive solver that stepped over a whole (grazing) contact is re-run with a smaller
   ``max_step`` (the result's ``settings`` say which); a solve whose energy balance is off by more
   than 10 % of the initial energy raises SimulationError.
-* The Exudyn model is released after every run (no growth over thousands of runs).
+* The Exudyn model is released after every run (no growth over thousands of runs); a
+  :class:`~mbs_models.engine.reuse.Simulator` keeps it for the next scene of the same structure instead
+  (:func:`simulate_with`), with bit-identical results.
 """
 
 from __future__ import annotations
