@@ -8,8 +8,9 @@
 1. **Points per second** of the paper's Figs 4/5 grid (models (i) and (ii), absorber masses 100, 500,
    1000 kg, gaps 0..120 mm in 1 mm steps: 726 points, ``stop_when_final=("max_barrel_displacement",)``,
    as validation/studies/report.py runs it), serially (one process): a fresh ``simulate`` per point (what
-   sweeps did before) against one :class:`~mbs_models.Simulator`, alternating the two over ``--rounds``
-   rounds, the ratio of the medians; the two must give the same displacements (``==``).
+   sweeps did before) against one :class:`~mbs_models.Simulator`, alternating point by point over
+   ``--rounds`` passes, the ratio of the totals, and where one point's time goes; the two must give the
+   same displacements (``==``).
 2. **Memory**: RSS over ``--memory-points`` short points (model (ii), masses and gaps cycling,
    0.2 s "draft" each) through one Simulator: the growth between the first tenth and the end must be ~0.
 
@@ -21,7 +22,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import statistics
 import sys
 import time
 from pathlib import Path
@@ -50,31 +50,41 @@ def figs_4_5_scenes():
     return [factory(mass, gap / 1000.0) for factory in (model_i, model_ii) for mass in MASSES for gap in GAPS_MM]
 
 
-def sweep_throughput(rounds: int = 3, progress=print) -> dict:
+def sweep_throughput(rounds: int = 2, progress=print) -> dict:
     """Points per second of the Figs 4/5 grid: fresh ``simulate`` per point against one Simulator (serial).
 
-    Returns ``{"points", "fresh_s", "reuse_s"}`` (median seconds per sweep) and ``"ratio"``
-    (fresh / reuse: the speed-up).  Raises if a displacement differs.
+    The two alternate point by point (which goes first alternates too), so that a shared machine's load
+    drifts into both alike; ``rounds`` passes over the grid.  Returns ``{"points", "fresh_s", "reuse_s"}``
+    (seconds per sweep, mean over the rounds), ``"ratio"`` (fresh / reuse: the speed-up) and the mean split
+    of one point (``"fresh_timings"``, ``"reuse_timings"``: set-up incl. assembly, solve, post-processing,
+    in s).  Raises if any displacement differs.
     """
     from mbs_models import Simulator, simulate
 
     scenes = figs_4_5_scenes()
-    fresh_times, reuse_times = [], []
-    for r in range(rounds):
-        start = time.perf_counter()
-        fresh = [simulate(s, 10.0, "standard", stop_when_final=EARLY).max_barrel_displacement for s in scenes]
-        fresh_times.append(time.perf_counter() - start)
-        with Simulator() as simulator:
-            start = time.perf_counter()
-            reused = [simulator.simulate(s, 10.0, "standard", stop_when_final=EARLY).max_barrel_displacement
-                      for s in scenes]
-            reuse_times.append(time.perf_counter() - start)
-        if fresh != reused:
-            raise AssertionError("the reused model gave other displacements than fresh assemblies")
-        progress(f"round {r + 1}: fresh {len(scenes) / fresh_times[-1]:.1f} points/s, "
-                 f"reuse {len(scenes) / reuse_times[-1]:.1f} points/s")
-    fresh_s, reuse_s = statistics.median(fresh_times), statistics.median(reuse_times)
-    return {"points": len(scenes), "fresh_s": fresh_s, "reuse_s": reuse_s, "ratio": fresh_s / reuse_s}
+    total = {"fresh": 0.0, "reuse": 0.0}
+    split: dict[str, dict[str, float]] = {"fresh": {}, "reuse": {}}
+    with Simulator() as simulator:
+        runs = {"fresh": simulate, "reuse": simulator.simulate}
+        for r in range(rounds):
+            for i, scene in enumerate(scenes):
+                values = {}
+                for kind in (("fresh", "reuse") if (i + r) % 2 else ("reuse", "fresh")):
+                    start = time.perf_counter()
+                    result = runs[kind](scene, 10.0, "standard", stop_when_final=EARLY)
+                    total[kind] += time.perf_counter() - start
+                    values[kind] = result.max_barrel_displacement
+                    for part, seconds in result.timings.items():
+                        split[kind][part] = split[kind].get(part, 0.0) + seconds
+                if values["fresh"] != values["reuse"]:
+                    raise AssertionError(f"the reused model gave another displacement for {scene.name}")
+            progress(f"round {r + 1}: fresh {len(scenes) * (r + 1) / total['fresh']:.1f} points/s, "
+                     f"reuse {len(scenes) * (r + 1) / total['reuse']:.1f} points/s (so far)")
+    runs_done = len(scenes) * rounds
+    return {"points": len(scenes), "fresh_s": total["fresh"] / rounds, "reuse_s": total["reuse"] / rounds,
+            "ratio": total["fresh"] / total["reuse"],
+            "fresh_timings": {k: v / runs_done for k, v in split["fresh"].items()},
+            "reuse_timings": {k: v / runs_done for k, v in split["reuse"].items()}}
 
 
 def memory_reuse(points: int = 10_000, end_time: float = 0.2, progress=print) -> list[tuple[int, int]]:
@@ -97,7 +107,7 @@ def memory_reuse(points: int = 10_000, end_time: float = 0.2, progress=print) ->
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--rounds", type=int, default=3, help="rounds of the sweep comparison (default 3)")
+    parser.add_argument("--rounds", type=int, default=2, help="passes over the grid (default 2)")
     parser.add_argument("--memory-points", type=int, default=10_000, help="points of the memory test (default 10000)")
     parser.add_argument("--skip-sweep", action="store_true")
     parser.add_argument("--skip-memory", action="store_true")
@@ -107,6 +117,9 @@ def main(argv=None) -> int:
         print(f"Figs 4/5 grid, {out['points']} points, serial: fresh {out['points'] / out['fresh_s']:.1f} points/s "
               f"[{out['fresh_s']:.1f} s], reuse {out['points'] / out['reuse_s']:.1f} points/s [{out['reuse_s']:.1f} s]: "
               f"x{out['ratio']:.2f}")
+        for kind in ("fresh", "reuse"):
+            parts = ", ".join(f"{k} {v * 1e3:.2f} ms" for k, v in out[f"{kind}_timings"].items())
+            print(f"  one point, {kind}: {parts}")
     if not args.skip_memory:
         marks = memory_reuse(args.memory_points)
         first = marks[1][1]
