@@ -90,7 +90,6 @@ def test_python_user_functions_are_bit_identical_too():
 #: Per shipped scene: a change of its numbers that keeps its structure (a second point to reuse with).
 VARIANTS = {
     "two_absorbers": {"absorber.1.contact.gap": 0.03, "absorber.0.mass": 300.0},
-    "end_stops": {"recoil_stop.position": 0.5, "contact.gap": 0.02},
     "burst": {"burst.interval": 0.9, "contact.gap": 0.01},
     "recuperator": {"recuperator.initial_pressure": 6.0e6},
     "realistic": {"recuperator.initial_pressure": 6.0e6, "cradle.elevation": 20.0},
