@@ -181,17 +181,17 @@ def test_each_process_has_its_own_simulator(monkeypatch):
 
 
 def test_a_sweep_reuses_per_process_and_gives_the_points_of_fresh_runs():
-    """run_sweep's points (serial: this process's Simulator; and in 2 worker processes) are those of
+    """run_scenes' points (serial: this process's Simulator; and in 2 worker processes) are those of
     ``simulate``; a failing point between them changes nothing."""
     from mbs_models import Conventions, SimulationError
     from mbs_models.engine import reuse
-    from mbs_models.studies.sweep import run_sweep
+    from mbs_models.studies.sweep import run_scenes
 
     scenes = [model_i(500.0, 0.0), model_ii(1000.0, 0.0, Conventions(compression_only=True)),  # fails
               model_ii(100.0, 0.03), model_i(1000.0, 0.08), model_ii(500.0, 0.11), model_i(100.0, 0.01)]
     before = reuse.process_simulator().reuses
     for workers in (1, 2):
-        points = run_sweep(scenes, 10.0, "standard", workers=workers, stop_when_final=EARLY)
+        points = run_scenes(scenes, 10.0, "standard", workers=workers, stop_when_final=EARLY)
         assert points[1].error is not None and "step budget" in points[1].error
         for scene, point in zip(scenes, points):
             if point.error is not None:
