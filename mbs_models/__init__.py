@@ -30,6 +30,7 @@ __version__ = "0.1.0"
 # name -> module that defines it; loaded lazily (PEP 562) because these import Exudyn.
 _LAZY = {
     "simulate": ".engine.simulation",
+    "Simulator": ".engine.reuse",             # simulate() keeping the assembled systems (sweeps)
     "Result": ".results.result",
     "Impact": ".results.result",
     "ContactOutput": ".results.result",

@@ -25,7 +25,15 @@ What it measures (not a timed test: the numbers depend on the machine; the ratio
    elements add), and of capturing the onset rate ``v-`` of the restitution laws inside the solve
    (``exact-restitution`` against Hunt-Crossley with the lambda it gives at v0: per step of the solve).
 
-Absolute times are printed only in brackets beside the ratios, for context.
+6. **Sweeps** (issue #11, :mod:`bench_throughput`, :mod:`bench_reuse`): the paper's Figs 4/5 grid (726 points,
+   with the early stop, as the report runs it) in fresh interpreters: points per second before issue #11
+   (commit ``c952992`` in a temporary git worktree) and now, serial; now with 2 workers (the speed-up from 1 to
+   2); on a 2-worker Dask ``LocalCluster``; and, in this process, a fresh ``simulate`` per point against one
+   reused :class:`~mbs_models.Simulator` (and, with the memory test, RSS over 10 000 reused points).
+7. **The whole-paper job**: wall time of a full ``recoil paper`` before issue #11 and now (``--paper``).
+
+It ends with issue #11's targets, each ratio beside its target.  Absolute times are printed only in
+brackets beside the ratios, for context.
 """
 
 from __future__ import annotations
@@ -47,6 +55,7 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # bench_throughput, bench_reuse
 
 C_SOURCE = Path(__file__).resolve().parent / "recoil_dopri5.c"
 
@@ -255,6 +264,13 @@ def main(argv=None) -> int:
                         help="simulated time of each memory-test run in s (default 0.05: the first impact)")
     parser.add_argument("--skip-memory", action="store_true")
     parser.add_argument("--skip-elements", action="store_true", help="skip the absorber-count and onset-capture costs")
+    parser.add_argument("--skip-sweeps", action="store_true", help="skip the Figs 4/5 sweep throughput")
+    parser.add_argument("--gap-count", type=int, default=121,
+                        help="gaps of the Figs 4/5 sweep per model and mass (default 121: 726 points)")
+    parser.add_argument("--sweep-rounds", type=int, default=3,
+                        help="alternating rounds of the sweep variants, the fastest of each taken (default 3)")
+    parser.add_argument("--paper", action="store_true",
+                        help="also time a full `recoil paper` before issue #11 and now (about a minute)")
     args = parser.parse_args(argv)
 
     def say(message: str) -> None:
@@ -378,6 +394,40 @@ def main(argv=None) -> int:
         memory = memory_test(scene, args.memory_runs, args.memory_end_time, say)
         memory_wall = time.perf_counter() - start
 
+    # ---------------------------------------------------------------- sweeps and the paper job
+    import bench_throughput as throughput
+
+    sweeps, paper, reuse = {}, {}, None
+    if not args.skip_sweeps or args.paper:
+        with throughput.baseline_checkout() as baseline:
+            if baseline is None:
+                say(f"no git history: the code before issue #11 ({throughput.BASELINE_REV}) is not measured")
+            if not args.skip_sweeps:
+                variants = [("before", baseline, 1, "local"), ("now", ROOT, 1, "local"), ("now 2 workers", ROOT, 2, "local")]
+                if throughput.dask_available():
+                    variants.append(("dask LocalCluster 2 workers", ROOT, 2, "local-cluster"))
+                runs: dict[str, list[dict]] = {}
+                for round_ in range(args.sweep_rounds):  # alternating: a shared machine's load drifts into all alike
+                    for name, tree, workers, kind in variants:
+                        if tree is not None:
+                            say(f"sweep: Figs 4/5 grid, {name} (round {round_ + 1} of {args.sweep_rounds})")
+                            runs.setdefault(name, []).append(throughput.sweep_once(tree, workers, kind, args.gap_count))
+                sweeps = {name: min(outs, key=lambda out: out["wall"]) for name, outs in runs.items()}
+                if args.gap_count == throughput.GAP_COUNT:
+                    import bench_reuse
+                    say("sweep: fresh simulate against one reused Simulator, in this process")
+                    reuse = bench_reuse.sweep_throughput(1, progress=say)
+            if args.paper:
+                for name, tree in (("before", baseline), ("now", ROOT)):
+                    if tree is not None:
+                        say(f"recoil paper, {name}")
+                        paper[name] = throughput.paper_once(tree)
+    reuse_memory = None
+    if not args.skip_memory and args.memory_runs > 0:
+        import bench_reuse
+        say(f"memory: {args.memory_runs} points through one reused Simulator")
+        reuse_memory = bench_reuse.memory_reuse(args.memory_runs, progress=say)
+
     # ---------------------------------------------------------------- report
     def err_text(errors):
         return ", ".join(f"{m.replace('max_', '').replace('_', ' ')} {errors[m]:.1e}" for m in metrics)
@@ -442,6 +492,46 @@ def main(argv=None) -> int:
         print(f"   onset capture (exact-restitution / Hunt-Crossley at the same first impact): solve per step "
               f"{law_solve / law_steps / (hc_solve / hc_steps):5.2f}x, complete run {law_run / hc_run:5.2f}x "
               f"[{law_steps} vs {hc_steps} steps]")
+    if reuse_memory is not None:
+        first = reuse_memory[1][1]
+        print(f"\n4b. memory over {reuse_memory[-1][0]} points through one reused Simulator (model (ii), masses and gaps "
+              f"cycling): RSS {first / 2**20:.1f} MiB after the first tenth, {reuse_memory[-1][1] / 2**20:.1f} MiB at the "
+              f"end ({(reuse_memory[-1][1] - first) / 2**20:+.2f} MiB)")
+    if sweeps:
+        print(f"\n6. sweeps: the Figs 4/5 grid with the early stop, fresh interpreters (points per second; the "
+              f"fastest of {args.sweep_rounds} alternating rounds)")
+        for name, out in sweeps.items():
+            print(f"   {name:30s} {out['points'] / out['wall']:7.1f} points/s  [{out['wall']:.1f} s wall, "
+                  f"{out['cpu']:.1f} s CPU in the parent]")
+        values = [out["values"] for out in sweeps.values()]
+        print(f"   every variant gives the same displacements: {all(v == values[0] for v in values)}")
+        if reuse is not None:
+            print(f"   in one process, serial: one reused Simulator / a fresh simulate per point: x{reuse['ratio']:.2f} "
+                  f"[{reuse['points'] / reuse['fresh_s']:.1f} vs {reuse['points'] / reuse['reuse_s']:.1f} points/s]")
+    if paper:
+        print("\n7. the whole-paper job (full `recoil paper`, wall time)")
+        for name, seconds in paper.items():
+            print(f"   {name:8s} {seconds:6.1f} s")
+
+    rows = []
+    if stages:
+        rows.append(("complete run / Exudyn solve", t_standard / t_standard_solve, "<= 1.3", t_standard / t_standard_solve <= 1.3))
+    if compiled is not None:
+        rows.append(("complete run / compiled DOPRI5", t_standard / compiled[0], "<= 12", t_standard / compiled[0] <= 12))
+    if lsoda is not None:
+        rows.append(("LSODA / complete run (equal accuracy)", lsoda[2] / t_standard, ">= 4", lsoda[2] / t_standard >= 4))
+    if "before" in sweeps and "now" in sweeps:
+        gain = sweeps["before"]["wall"] / sweeps["now"]["wall"]
+        rows.append(("Figs 4/5 sweep, points/s now / before", gain, ">= 2", gain >= 2))
+    if "now 2 workers" in sweeps and "now" in sweeps:
+        gain = sweeps["now"]["wall"] / sweeps["now 2 workers"]["wall"]
+        rows.append(("sweep, 2 workers / 1 worker", gain, ">= 1.8", gain >= 1.8))
+    if "now" in paper:
+        rows.append(("full recoil paper, wall s" + (f" (before: {paper['before']:.1f} s)" if "before" in paper else ""),
+                     paper["now"], "<= 8 s", paper["now"] <= 8))
+    print("\nissue #11's targets (ratios of this run; the machine's load affects the wall-time ones)")
+    for name, value, target, met in rows:
+        print(f"   {name:55s} {value:7.2f}   target {target:8s} {'met' if met else 'NOT met'}")
     return 0
 
 

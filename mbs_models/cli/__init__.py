@@ -37,8 +37,10 @@ class _Parser(argparse.ArgumentParser):
         raise SceneError("", f"{message} (see '{self.prog} --help')")
 
 
-def _progress(message: str) -> None:
-    print(f"[recoil] {message}", file=sys.stderr, flush=True)
+def _progress():
+    """Stage lines and tqdm bars on stderr, quiet when stderr is not a terminal."""
+    from .progress import ProgressBars
+    return ProgressBars(sys.stderr)
 
 
 def _resolve_scene(path: str):
@@ -64,7 +66,7 @@ def _cmd_paper(args) -> int:
         options = ReportOptions.reproduction(workers=args.workers)
     else:
         options = ReportOptions(workers=args.workers)
-    data = write_report(args.out, options, progress=_progress)
+    data = write_report(args.out, options, progress=_progress())
     print(table2_markdown(table2_rows(data)))
     failed = [c["scene"] for c in data["comparisons"] if not c["passed"]]
     print(f"wrote report.html, results.json, table2.md/json and the figures to {args.out} "
@@ -100,12 +102,13 @@ def _cmd_precision(args) -> int:
         raise SceneError("--repeats", f"must be a whole number >= 1, got {args.repeats}")
     out = prepare_output_dir(args.out)
     start = time.perf_counter()
-    study = run_study(scene, end_time=args.end_time, repeats=args.repeats, quick=args.quick, progress=_progress)
+    progress = _progress()
+    study = run_study(scene, end_time=args.end_time, repeats=args.repeats, quick=args.quick, progress=progress)
     study.write(out)
     print(study.summary_markdown().split("\n## All settings")[0])
     if args.presets:
-        _progress("accuracy presets on the 19 paper cases")
-        presets = preset_study(end_time=args.end_time, repeats=args.repeats, progress=_progress)
+        progress("accuracy presets on the 19 paper cases")
+        presets = preset_study(end_time=args.end_time, repeats=args.repeats, progress=progress)
         presets.write(out)
         print(presets.table_markdown())
     print(f"wrote precision.md, precision.csv, precision.json, the work-precision figures"

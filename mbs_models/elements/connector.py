@@ -126,16 +126,34 @@ class Connector:
         index = mbs.AddObject(ObjectConnectorCoordinateSpringDamper(
             markerNumbers=[marker_a, marker_b], stiffness=self.stiffness, damping=self.damping,
             visualization={"show": False, "drawSize": -1.0, "color": [-1.0, -1.0, -1.0, -1.0]}))
-        if self.needs_user_function:
-            law = self.user_function_law(ops_for(user_functions))
-
-            def user_function(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
-                return law(displacement, velocity)
-
-            self._user_function = make_user_function(mbs, user_function, user_functions, index)
-            mbs.SetObjectParameter(index, "springForceUserFunction", self._user_function)
+        self._set_user_function(mbs, index, user_functions)
         self.index = index
         return index
+
+    def update_items(self, mbs, index, user_functions: str = "symbolic") -> None:
+        """Write this connector's numbers into ``index``, the item :meth:`add_items` made for a connector of
+        the same class and ends (an earlier point of a sweep; :mod:`mbs_models.engine.reuse`).
+
+        Afterwards the item is what :meth:`add_items` would have made: ``stiffness`` and ``damping`` set, the
+        user function (if any) recorded anew from this connector's law.  A subclass that adds other items
+        overrides both methods.
+        """
+        mbs.SetObjectParameter(index, "stiffness", self.stiffness)
+        mbs.SetObjectParameter(index, "damping", self.damping)
+        self._set_user_function(mbs, index, user_functions)
+        self.index = index
+
+    def _set_user_function(self, mbs, index, user_functions: str) -> None:
+        """Record :meth:`user_function_law` as the item's spring-force user function (if the law needs one)."""
+        if not self.needs_user_function:
+            return
+        law = self.user_function_law(ops_for(user_functions))
+
+        def user_function(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
+            return law(displacement, velocity)
+
+        self._user_function = make_user_function(mbs, user_function, user_functions, index)
+        mbs.SetObjectParameter(index, "springForceUserFunction", self._user_function)
 
     # ------------------------------------------------------------------ energy
     @property
@@ -270,21 +288,33 @@ class Load:
 
         index = mbs.AddLoad(LoadCoordinate(markerNumber=marker, load=self.constant,
                                            visualization={"show": False}))
-        if self.needs_user_function:
-            ops = ops_for(user_functions)
-            law = self.law
-
-            def user_function(mbs, t, load):
-                return law(t, ops)
-
-            if user_functions == "python":
-                self._user_function = user_function
-            else:
-                from exudyn.advancedUtilities import CreateSymbolicUserFunction
-                self._user_function = CreateSymbolicUserFunction(mbs, user_function, "loadUserFunction", index)
-            mbs.SetLoadParameter(index, "loadUserFunction", self._user_function)
+        self._set_user_function(mbs, index, user_functions)
         self.index = index
         return index
+
+    def update_items(self, mbs, index, user_functions: str = "symbolic") -> None:
+        """Write this load's numbers into ``index``, the item :meth:`add_items` made for a load of the same
+        class and body (an earlier point of a sweep): the constant and, if any, the user function recorded anew."""
+        mbs.SetLoadParameter(index, "load", self.constant)
+        self._set_user_function(mbs, index, user_functions)
+        self.index = index
+
+    def _set_user_function(self, mbs, index, user_functions: str) -> None:
+        """Record :meth:`law` as the item's load user function (if the load needs one)."""
+        if not self.needs_user_function:
+            return
+        ops = ops_for(user_functions)
+        law = self.law
+
+        def user_function(mbs, t, load):
+            return law(t, ops)
+
+        if user_functions == "python":
+            self._user_function = user_function
+        else:
+            from exudyn.advancedUtilities import CreateSymbolicUserFunction
+            self._user_function = CreateSymbolicUserFunction(mbs, user_function, "loadUserFunction", index)
+        mbs.SetLoadParameter(index, "loadUserFunction", self._user_function)
 
     # ------------------------------------------------------------------ energy
     def work(self, quadrature: Quadrature, position, velocity_nodes, times_nodes):

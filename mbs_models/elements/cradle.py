@@ -205,6 +205,12 @@ class CradleFriction(Connector):
             visualization={"show": False, "drawSize": -1.0, "color": [-1.0, -1.0, -1.0, -1.0]}))
         return self.index
 
+    def update_items(self, mbs, index, user_functions: str = "symbolic") -> None:
+        """Write mu N and v_reg into ``index``, an item :meth:`add_items` made (an earlier point of a sweep)."""
+        mbs.SetObjectParameter(index, "dynamicFrictionForce", self.friction_force)
+        mbs.SetObjectParameter(index, "frictionProportionalZone", self.friction_velocity)
+        self.index = index
+
     # ------------------------------------------------------------------ energy and bounds
     @property
     def dissipates(self) -> bool:

@@ -50,6 +50,8 @@ class Assembly:
     loads: load name -> LoadIndex (``breech_force``, ``gravity``): external forces on a body.
     sensors: name -> SensorIndex (``barrel_position`` ... ``absorber_acceleration``, ``contact_force``).
     coordinates: body name -> index of its coordinate in the system's ODE2 coordinates.
+    masses: body name -> ObjectIndex of its ``ObjectMass1D``.
+    structure: :func:`structure_key` of the system (what :func:`refill` needs to match).
     """
 
     scene: Scene
@@ -64,6 +66,8 @@ class Assembly:
     loads: dict[str, Any] = field(default_factory=dict)
     sensors: dict[str, Any] = field(default_factory=dict)
     coordinates: dict[str, int] = field(default_factory=dict)
+    masses: dict[str, Any] = field(default_factory=dict)
+    structure: tuple = ()
 
     def close(self) -> None:
         """Release the Exudyn model (needed for symbolic user functions to be freed)."""
@@ -81,14 +85,38 @@ class Assembly:
         self.close()
 
 
-def add_body(mbs, mass: float, initial_velocity: float = 0.0, initial_position: float = 0.0):
+def add_body(mbs, mass: float, initial_velocity: float = 0.0, initial_position: float = 0.0, *,
+             with_mass_object: bool = False):
     """Add a 1-D body (m in kg, at ``initial_position`` m, default 0, with ``initial_velocity`` m/s) to ``mbs``:
-    (node, coordinate marker).  The reference coordinate is 0: the node's coordinate is the position x."""
+    (node, coordinate marker), and the ``ObjectMass1D``'s index third if ``with_mass_object``.  The reference
+    coordinate is 0: the node's coordinate is the position x."""
     node = mbs.AddNode(NodeGenericODE2(referenceCoordinates=[0.0], initialCoordinates=[initial_position],
                                        initialCoordinates_t=[initial_velocity], numberOfODE2Coordinates=1))
-    mbs.AddObject(ObjectMass1D(nodeNumber=node, mass=mass))
+    mass_object = mbs.AddObject(ObjectMass1D(nodeNumber=node, mass=mass))
     marker = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=node, coordinate=0))
-    return node, marker
+    return (node, marker, mass_object) if with_mass_object else (node, marker)
+
+
+def update_body(mbs, node, mass_object, mass: float, initial_velocity: float, initial_position: float) -> None:
+    """Write a body's mass (kg) and initial state (m, m/s) into the node and ``ObjectMass1D`` :func:`add_body` made;
+    the system must be assembled again (``mbs.Assemble()``) for the initial state to take effect."""
+    mbs.SetObjectParameter(mass_object, "mass", mass)
+    mbs.SetNodeParameter(node, "initialCoordinates", [initial_position])
+    mbs.SetNodeParameter(node, "initialCoordinates_t", [initial_velocity])
+
+
+def structure_key(mechanism: Mechanism, user_functions: str) -> tuple:
+    """What an assembled system is made of, without its numbers: the backend, the bodies (names, in order), the
+    connectors (class, name, ends, whether a user function and a force sensor) and the loads (class, name, body,
+    user function), element by element.  Two scenes with the same key assemble to the same items; only
+    masses, stiffnesses, laws' constants and initial states differ (see :func:`refill`)."""
+    return (user_functions, tuple(
+        (element.name, type(element.table).__name__,
+         tuple(body.name for body in element.bodies),
+         tuple((type(c).__qualname__, c.name, c.a, c.b, c.needs_user_function, c.records_force)
+               for c in element.connectors),
+         tuple((type(load).__qualname__, load.name, load.body, load.needs_user_function) for load in element.loads))
+        for element in mechanism.elements))
 
 
 def assemble(scene: Scene, user_functions: str = "symbolic", mechanism: Mechanism | None = None) -> Assembly:
@@ -104,8 +132,10 @@ def assemble(scene: Scene, user_functions: str = "symbolic", mechanism: Mechanis
     assembly.markers[GROUND] = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=ground, coordinate=0))
     for element in mechanism.elements:
         for body in element.bodies:
-            node, marker = add_body(mbs, body.mass, body.initial_velocity, body.initial_position)
+            node, marker, mass_object = add_body(mbs, body.mass, body.initial_velocity, body.initial_position,
+                                                 with_mass_object=True)
             assembly.nodes[body.name], assembly.markers[body.name] = node, marker
+            assembly.masses[body.name] = mass_object
             for quantity, ovt in (("position", _OVT.Coordinates), ("velocity", _OVT.Coordinates_t),
                                   ("acceleration", _OVT.Coordinates_tt)):
                 assembly.sensors[f"{body.name}_{quantity}"] = mbs.AddSensor(
@@ -124,7 +154,43 @@ def assemble(scene: Scene, user_functions: str = "symbolic", mechanism: Mechanis
     mbs.Assemble()
     data = mbs.systemData
     assembly.coordinates = {name: data.GetNodeLTGODE2(node)[0] for name, node in assembly.nodes.items()}
+    assembly.structure = structure_key(mechanism, user_functions)
+    _start_contacts(mechanism)
+    return assembly
+
+
+def _start_contacts(mechanism: Mechanism) -> None:
+    """Give the contacts that capture their onset rate the state at t = 0."""
     velocities = {body.name: body.initial_velocity for body in mechanism.bodies}
     for contact in mechanism.capturing_contacts:
         contact.start(mechanism.initial_relative(contact), mechanism.relative(contact, velocities))
-    return assembly
+
+
+def refill(assembly: Assembly, scene: Scene, mechanism: Mechanism) -> Assembly:
+    """The system of ``assembly`` made into the one :func:`assemble` builds for ``scene`` (same
+    :func:`structure_key`): every body's mass and initial state, and every connector's and load's numbers and user
+    function (their ``update_items``), written in place; then ``mbs.Assemble()`` (the initial state, as at the
+    first assembly), no pre-step function.  Returns the new :class:`Assembly` (``assembly`` must not be used
+    any more).  ValueError if the structures differ."""
+    backend = assembly.backend
+    key = structure_key(mechanism, backend)
+    if key != assembly.structure:
+        raise ValueError("the scene's structure differs from the assembled system's")
+    mbs = assembly.mbs
+    for body in mechanism.bodies:
+        update_body(mbs, assembly.nodes[body.name], assembly.masses[body.name], body.mass, body.initial_velocity,
+                    body.initial_position)
+    for connector in mechanism.connectors:
+        connector.update_items(mbs, assembly.connectors[connector.name], backend)
+    for load in mechanism.loads:
+        load.update_items(mbs, assembly.loads[load.name], backend)
+    mbs.SetPreStepUserFunction(0)
+    mbs.Assemble()
+    refilled = Assembly(scene=scene, mechanism=mechanism, system_container=assembly.system_container, mbs=mbs,
+                        backend=backend, nodes=assembly.nodes, markers=assembly.markers,
+                        connectors=assembly.connectors, user_function_connectors=assembly.user_function_connectors,
+                        loads=assembly.loads, sensors=assembly.sensors, coordinates=assembly.coordinates,
+                        masses=assembly.masses, structure=key)
+    assembly.system_container = assembly.mbs = None  # the system now belongs to the new Assembly
+    _start_contacts(mechanism)
+    return refilled

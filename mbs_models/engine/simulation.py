@@ -17,7 +17,9 @@ Contract
   limit); an adaptive solver that stepped over a whole (grazing) contact is re-run with a smaller
   ``max_step`` (the result's ``settings`` say which); a solve whose energy balance is off by more
   than 10 % of the initial energy raises SimulationError.
-* The Exudyn model is released after every run (no growth over thousands of runs).
+* The Exudyn model is released after every run (no growth over thousands of runs); a
+  :class:`~mbs_models.engine.reuse.Simulator` keeps it for the next scene of the same structure instead
+  (:func:`simulate_with`), with bit-identical results.
 """
 
 from __future__ import annotations
@@ -451,6 +453,31 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
     stability.AccuracyWarning: a fixed step resolves impacts with fewer than 10 steps, or the energy
         balance is off by more than 1 % of the initial energy.
     """
+    return simulate_with(FRESH_MODELS, scene, end_time, accuracy, user_functions=user_functions,
+                         impact_threshold=impact_threshold, stop_when_final=stop_when_final)
+
+
+class FreshModels:
+    """Where :func:`simulate_with` gets its Exudyn systems: a new :func:`~mbs_models.engine.assembly.assemble`
+    for every solve, closed after it.  :class:`mbs_models.engine.reuse.Simulator` keeps them instead."""
+
+    def acquire(self, scene: Scene, user_functions: str, mechanism: Mechanism) -> Assembly:
+        """An assembled system of ``scene`` (with ``mechanism``'s connectors bound to it), ready to solve."""
+        return assemble(scene, user_functions, mechanism)
+
+    def release(self, assembly: Assembly, failed: bool) -> None:
+        """The solve with ``assembly`` is over (``failed``: it raised)."""
+        assembly.close()
+
+
+FRESH_MODELS = FreshModels()
+
+
+def simulate_with(models: FreshModels, scene: Scene, end_time: float = 10.0,
+                  accuracy: str | SolverSettings = "standard", *, user_functions: str | None = None,
+                  impact_threshold: float = 1000.0, stop_when_final: Sequence[str] = ()) -> Result:
+    """:func:`simulate` with the Exudyn systems of ``models`` (:class:`FreshModels` or a
+    :class:`~mbs_models.engine.reuse.Simulator`): the same contract."""
     _check_arguments(scene, end_time, impact_threshold)
     requested = check_metric_names(stop_when_final)
     settings = solver_settings_for(accuracy, user_functions)
@@ -461,8 +488,9 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
     while True:
         mechanism = Mechanism(scene)  # fresh: contacts carry the onset capture of one solve
         tracker = FinalityTracker(mechanism, requested, impact_threshold) if early_stop else None
-        assembly = assemble(scene, settings.user_functions, mechanism)
+        assembly = models.acquire(scene, settings.user_functions, mechanism)
         t_assembled = _time.perf_counter()
+        failed = True
         try:
             if mechanism.breakpoints or mechanism.loads:
                 steps, simulated_end, samples = _run_segments(assembly, settings, float(end_time), tracker)
@@ -472,6 +500,7 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
                 steps, simulated_end = _solve(assembly, settings, float(end_time), tracker)
                 t_solved = _time.perf_counter()
                 samples = _collect(assembly, simulated_end, settings, initial_accelerations)
+            failed = False
         except _StepSizeStalled as stalled:
             retry = _absolute_tolerance_settings(settings) if settings.adaptive else None
             if retry is None:
@@ -479,7 +508,7 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
             settings = retry  # once: the re-solve with absolute error control (see the function)
             continue
         finally:
-            assembly.close()
+            models.release(assembly, failed)
         retry = _settings_after_stepped_over_contacts(mechanism, samples, settings, float(impact_threshold), attempt)
         attempt += 1
         if retry is None:
@@ -510,7 +539,7 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
     floor = tracker.bounds.energy_floor if stopped else 0.0  # the energy's lower bound (a preload's well)
     if stopped and largest_energy_rise(mechanical - floor) > ENERGY_SLACK:
         # the solution's energy rose by more than the bounds' slack: do not trust the early stop
-        result = simulate(scene, end_time, settings, impact_threshold=impact_threshold)
+        result = simulate_with(models, scene, end_time, settings, impact_threshold=impact_threshold)
         result.stop_reason = STOP_ENERGY_CHECK
         result.wall_time = _time.perf_counter() - t_start
         return result

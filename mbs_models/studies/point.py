@@ -59,11 +59,15 @@ class PointSettings:
 
 
 def simulate_scene(scene: Scene, settings: PointSettings):
-    """The :class:`~mbs_models.Result` of one scene: the single call of ``simulate`` of every sweep."""
-    from ..engine.simulation import simulate
+    """The :class:`~mbs_models.Result` of one scene: the single call of ``simulate`` of every sweep.
 
-    return simulate(scene, settings.end_time, settings.accuracy, impact_threshold=settings.impact_threshold,
-                    stop_when_final=settings.stop_when_final)
+    It runs on this process's :class:`~mbs_models.engine.reuse.Simulator`: the points of one structure
+    reuse one assembled system per worker process, with the results of ``simulate`` bit for bit."""
+    from ..engine.reuse import process_simulator
+
+    return process_simulator().simulate(scene, settings.end_time, settings.accuracy,
+                                        impact_threshold=settings.impact_threshold,
+                                        stop_when_final=settings.stop_when_final)
 
 
 def _stops(scene: Scene) -> list[str]:

@@ -52,7 +52,8 @@ def _ii_max_at_gap_zero(e: ClaimEvidence):
             return None, "no gap sweep in the evidence"
         gap, value = max(sweep, key=lambda p: p[1])
         holds &= gap == 0.0
-        parts.append(f"m = {mass:g} kg: largest {value:.4f} m at gap {gap * 1e3:g} mm (gap 0: {sweep[0][1]:.4f} m)")
+        parts.append(f"m = {mass:g} kg: largest {value * 1e3:.1f} mm at gap {gap * 1e3:g} mm "
+                     f"(gap 0: {sweep[0][1] * 1e3:.1f} mm)")
     return holds, "; ".join(parts)
 
 
@@ -67,25 +68,27 @@ def _checks() -> dict[str, Callable[[ClaimEvidence], tuple[bool | None, str]]]:
         "ii_max_at_gap_zero": _ii_max_at_gap_zero,
         "i_m100_close_to_simplified": lambda e: (
             _rel(x(e, MODEL_I, 100.0), s(e)) < 0.03,
-            f"model (i) {x(e, MODEL_I, 100.0):.4f} m vs simplified {s(e):.4f} m "
+            f"model (i) {x(e, MODEL_I, 100.0) * 1e3:.1f} mm vs simplified {s(e) * 1e3:.1f} mm "
             f"({_rel(x(e, MODEL_I, 100.0), s(e)) * 100:.2f} %)"),
         "ii_m100_lower_than_simplified": lambda e: (
-            x(e, MODEL_II, 100.0) < s(e), f"model (ii) {x(e, MODEL_II, 100.0):.4f} m vs simplified {s(e):.4f} m"),
+            x(e, MODEL_II, 100.0) < s(e),
+            f"model (ii) {x(e, MODEL_II, 100.0) * 1e3:.1f} mm vs simplified {s(e) * 1e3:.1f} mm"),
         "ii_m100_equals_simplified": lambda e: (
             abs(x(e, MODEL_II, 100.0) - s(e)) < 5e-5,
-            f"model (ii) {x(e, MODEL_II, 100.0):.4f} m vs simplified {s(e):.4f} m"),
+            f"model (ii) {x(e, MODEL_II, 100.0) * 1e3:.1f} mm vs simplified {s(e) * 1e3:.1f} mm"),
         "i_difference_grows_with_m": lambda e: (
             x(e, MODEL_I, 100.0) > x(e, MODEL_I, 500.0) > x(e, MODEL_I, 1000.0),
-            ", ".join(f"{m:g} kg: {x(e, MODEL_I, m):.4f} m" for m in (100.0, 500.0, 1000.0))),
+            ", ".join(f"{m:g} kg: {x(e, MODEL_I, m) * 1e3:.1f} mm" for m in (100.0, 500.0, 1000.0))),
         "ii_decreases_with_m": lambda e: (
             x(e, MODEL_II, 100.0) > x(e, MODEL_II, 500.0) > x(e, MODEL_II, 1000.0)
             and x(e, MODEL_II, 1000.0) < 0.8 * s(e),
-            ", ".join(f"{m:g} kg: {x(e, MODEL_II, m):.4f} m" for m in (100.0, 500.0, 1000.0))
-            + f"; simplified {s(e):.4f} m"),
+            ", ".join(f"{m:g} kg: {x(e, MODEL_II, m) * 1e3:.1f} mm" for m in (100.0, 500.0, 1000.0))
+            + f"; simplified {s(e) * 1e3:.1f} mm"),
         "absorber_reduces_displacement": lambda e: (
             all(x(e, model, m) <= s(e) for model in (MODEL_I, MODEL_II) for m in (100.0, 500.0, 1000.0)),
-            f"largest with an absorber {max(x(e, mo, m) for mo in (MODEL_I, MODEL_II) for m in (100.0, 500.0, 1000.0)):.4f}"
-            f" m vs simplified {s(e):.4f} m"),
+            f"largest with an absorber "
+            f"{max(x(e, mo, m) for mo in (MODEL_I, MODEL_II) for m in (100.0, 500.0, 1000.0)) * 1e3:.1f}"
+            f" mm vs simplified {s(e) * 1e3:.1f} mm"),
         "first_peaks_similar": lambda e: (
             _rel(e.runs[MODEL_I].peak_contact_force, e.runs[MODEL_II].peak_contact_force) < 0.05,
             f"{e.runs[MODEL_I].peak_contact_force / 1e3:.1f} kN vs {e.runs[MODEL_II].peak_contact_force / 1e3:.1f} kN"),

@@ -20,6 +20,7 @@ from mbs_models.scene import Scene
 from mbs_models.studies.sweep import parallel_map
 
 from .paper import MODEL_I, MODEL_II, SIMPLIFIED, TABLE2_MASSES, published, table2
+from .progress import named
 from ..reference import solve_reference
 
 #: (label, conventions) of the readings studied: the default and each flag alone.
@@ -152,6 +153,6 @@ def study_conventions(cases=CONVENTION_CASES, *, workers: int | None = None, pro
     """Run every reading (reference and engine, in parallel) and return one row each."""
     jobs = convention_jobs(cases)
     scenes = [scene for _, _, scene in jobs]
-    reference = parallel_map(_reference_job, scenes, workers=workers, progress=progress)
-    engine = parallel_map(_engine_job, scenes, workers=workers, progress=progress)
+    reference = parallel_map(_reference_job, scenes, workers=workers, progress=named(progress, "reference pass"))
+    engine = parallel_map(_engine_job, scenes, workers=workers, progress=named(progress, "engine pass"))
     return convention_rows(cases, jobs, reference, engine)

@@ -8,6 +8,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+#: The title of the paper replicated (its authors are not given in the copy studied).
+PAPER_TITLE = "Analysis of a dynamic system subjected to an impulsive and internal contact force"
+
 SIMPLIFIED, MODEL_I, MODEL_II, ALL = "simplified", "model (i)", "model (ii)", "all"
 #: Absorber masses of Table 2 and Figs. 6-8, kg.
 TABLE2_MASSES = (100.0, 500.0, 1000.0)

@@ -68,6 +68,8 @@ from mbs_models.scene.models import model_i, model_ii, simplified_model
 from mbs_models.results.peaks import runs_of_true
 from mbs_models.scene import Scene
 
+from .progress import counter
+
 
 #: Metrics of the study, in the order of the tables and figures.
 METRICS = ("max_barrel_displacement", "peak_contact_force", "max_absorber_velocity", "barrel_trajectory_l2")
@@ -272,7 +274,7 @@ def compute_truths(scenes: Sequence[Scene], end_time: float = 10.0, *, check_rto
     from mbs_models.studies.sweep import parallel_map
 
     return parallel_map(_truth_job, [(s, float(end_time), check_rtol) for s in scenes], workers=workers,
-                        progress=lambda i, n: progress(f"truth {i}/{n}"))
+                        progress=counter(progress, "truths (event-driven reference)", "case"))
 
 
 # ================================================================================================
@@ -972,17 +974,18 @@ def run_study(scene: Scene, settings: Sequence[Setting] | None = None, *, end_ti
         truth = compute_truth(scene, end_time)
     _warm_up(scene, end_time)
     outcomes = []
+    first_runs = counter(progress, "settings, first run", "setting")
     for i, setting in enumerate(settings):
         outcome = run_setting(setting, scene, truth, repeats=1, long_run=long_run)
         outcomes.append(outcome)
-        errors = ", ".join(f"{k[:12]} {_fmt(v, '.1e')}" for k, v in outcome.errors.items() if v is not None)
-        progress(f"[{i + 1}/{len(settings)}] {setting.label()}: {outcome.status}"
-                 + (f", {outcome.median_time:.3g} s, {errors}" if outcome.median_time is not None else ""))
+        first_runs(i + 1, len(settings), f"{setting.label()}: {outcome.status}"
+                   + (f", {outcome.median_time:.3g} s" if outcome.median_time is not None else ""))
     for round_ in range(2, max(1, repeats) + 1):
         timed = [o for o in outcomes if o.median_time is not None and o.median_time <= long_run]
-        progress(f"timing round {round_}/{repeats}: {len(timed)} settings")
-        for outcome in timed:
+        timing = counter(progress, f"timing round {round_}/{repeats}", "setting")
+        for i, outcome in enumerate(timed):
             time_again(outcome, scene, truth)
+            timing(i + 1, len(timed))
     return Study(scene=scene, truth=truth, outcomes=outcomes, repeats=repeats, wall_time=time.perf_counter() - start)
 
 
@@ -1115,7 +1118,8 @@ def preset_study(presets: dict[str, Any] | None = None, cases: Sequence[tuple[st
     _warm_up(cases[0][1], end_time)
     times: dict[tuple[str, str], list[float]] = {}
     results: dict[str, list[PresetCase]] = {name: [] for name in presets}
-    for (case, scene), truth in zip(cases, truths):
+    done = counter(progress, "presets, first run", "case")
+    for number, ((case, scene), truth) in enumerate(zip(cases, truths), 1):
         for name, settings in presets.items():
             start = time.perf_counter()
             result = simulate(scene, end_time, settings)
@@ -1126,7 +1130,7 @@ def preset_study(presets: dict[str, Any] | None = None, cases: Sequence[tuple[st
             results[name].append(PresetCase(case=case, errors=errors, impacts=len(values.impacts),
                                             truth_impacts=len(truth.impacts), impacts_ok=not (missed or extra),
                                             median_time=0.0, steps=result.steps))
-        progress(f"presets: {case} done")
+        done(number, len(cases), case)
     for _ in range(max(1, repeats) - 1):  # interleaved timing rounds (see run_study)
         for case, scene in cases:
             for name, settings in presets.items():

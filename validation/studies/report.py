@@ -1,12 +1,17 @@
 """The replication report: ``recoil paper --out DIR`` writes ``report.html`` and ``results.json``.
 
 One self-contained HTML file (figures embedded as PNG data) for a reviewer of the replication:
-the models and their equations, parameters, Table 2 (ours, paper, difference), the gap sweeps
-(Figs 4-5), time histories (Figs 6-8), contact force and absorber velocity (Figs 9-11),
+a header (the paper replicated; date, package version and commit, libraries, machine), the verdict
+in one paragraph, the table of contents, the models and their equations, parameters, Table 2
+(ours, paper, difference), the gap sweeps (Figs 4-5), time histories (Figs 6-8) and the energy
+of each element (m = 1000 kg), contact force and absorber velocity (Figs 9-11),
 engine-vs-reference errors for every case shown, the convention study, the contact-law
 calibration, the paper's qualitative claims checked, and a plain list of every published number we
 cannot reproduce with its most likely reason.  PNG files, ``table2.md`` and ``table2.json`` are
 written beside it.  Everything is written under a temporary name and renamed.
+
+The page shows displacements in mm and forces in kN (:data:`DISPLAY_UNITS`); ``results.json`` and
+``table2.json`` stay in SI units.
 """
 
 from __future__ import annotations
@@ -17,6 +22,7 @@ import importlib
 import math
 import multiprocessing
 import os
+import re
 import textwrap
 import time
 import warnings
@@ -39,6 +45,8 @@ from .compare import compare
 from .conventions import (CONVENTION_CASES, TREND_GAPS, convention_jobs, convention_rows, engine_job,
                           reference_job)
 from .paper import MODEL_I, MODEL_II, SIMPLIFIED, TABLE2_MASSES, published, published_values, table2
+from .progress import counter
+from .provenance import FIELDS as PROVENANCE_FIELDS, provenance
 
 Progress = Callable[[str], None]
 #: A published number counts as reproduced when ours is within this relative difference.
@@ -106,11 +114,8 @@ def _comparison_scenes(options: ReportOptions) -> list[Scene]:
 
 
 def _counter(progress: Progress, label: str):
-    """A (done, total) progress callback that reports roughly every quarter."""
-    def report(done: int, total: int) -> None:
-        if done == total or done % max(1, total // 4) == 0:
-            progress(f"  {label}: {done}/{total}")
-    return report
+    """A (done, total) progress callback: a tqdm bar from the command line, else a line about every quarter."""
+    return counter(progress, label)
 
 
 def _timed(function: Callable, *args) -> tuple[float, object]:
@@ -280,7 +285,7 @@ def _sweep_figure(data: dict, model: str, fig_number: int):
         ax.plot([r[0] * 1e3 for r in reference], [r[1] * 1e3 for r in reference], "kx", ms=7,
                 label="independent reference")
     simple = data["runs"][SIMPLIFIED].max_barrel_displacement
-    ax.axhline(simple * 1e3, color=MODEL_COLOURS[SIMPLIFIED], ls="--", lw=1, label=f"simplified {simple:.4f} m")
+    ax.axhline(simple * 1e3, color=MODEL_COLOURS[SIMPLIFIED], ls="--", lw=1, label=f"simplified {simple * 1e3:.1f} mm")
     ax.set_xlabel("gap [mm]")
     ax.set_ylabel("max barrel displacement [mm]")
     ax.set_title(f"Fig. {fig_number}: max barrel displacement vs gap, {model}", fontsize=11)
@@ -288,12 +293,62 @@ def _sweep_figure(data: dict, model: str, fig_number: int):
     return fig
 
 
+#: Each reading of the paper (the flags of :class:`mbs_models.Conventions`, :data:`CONVENTION_CASES`) in plain
+#: words for the text, and a short name for legends.
+READINGS = {
+    "default": ("our reading: the exact initial velocity, the contact damping as in Hunt-Crossley, the gap as a "
+                "clearance", "default"),
+    "literal_lambda_sign": ("the contact damping's sign as printed in Eq. (6), which adds energy during compression",
+                            "damping sign as printed"),
+    "compression_only": ("the contact force acts only while the contact is being compressed", "compression only"),
+    "v0_includes_absorber": ("the initial velocity includes the absorber's mass, in model (i)",
+                             "v0 includes the absorber"),
+    "rounded_initial_velocity": ("the initial velocity as printed, 0.7 m/s, instead of 0.6909 m/s", "v0 = 0.7 m/s"),
+    "literal_gap_sign": ("the gap's sign as printed in Eq. (6), which makes the gap an interference",
+                         "gap sign as printed"),
+}
+
+
+def reading_text(label: str) -> str:
+    """A reading of the paper in plain words."""
+    return READINGS.get(label, (label.replace("_", " "),))[0]
+
+
+def reading_short(label: str) -> str:
+    return READINGS.get(label, (None, label.replace("_", " ")))[1]
+
+
+def coinciding_readings(rows) -> dict[str, str]:
+    """Readings whose Fig. 5 trend equals an earlier reading's (label -> that earlier label): their lines coincide."""
+    out: dict[str, str] = {}
+    for i, row in enumerate(rows):
+        for earlier in rows[:i]:
+            if earlier.label not in out and np.allclose(row.trend(), earlier.trend(), rtol=1e-9, atol=0.0):
+                out[row.label] = earlier.label
+                break
+    return out
+
+
+#: (line style, marker) per reading of the convention figure: no two alike, so that no line hides another.
+_READING_STYLES = (("-", "o"), ("--", "s"), ("-.", "^"), (":", "D"), ("-", "v"), ("--", "P"), ("-.", "X"), (":", "*"))
+
+
 def _convention_figure(data: dict):
     from mbs_models.results.plotting import new_figure
     fig, axes = new_figure(1, 1, row_height=3.6)
     ax = axes[0, 0]
-    for row in data["conventions"]:
-        ax.plot(np.array(TREND_GAPS) * 1e3, np.array(row.trend()) * 1e3, "o-", label=row.label)
+    rows = data["conventions"]
+    same = coinciding_readings(rows)
+    for i, row in enumerate(rows):
+        style, marker = _READING_STYLES[i % len(_READING_STYLES)]
+        label = reading_short(row.label)
+        if row.label in same:   # drawn over the line it equals: hollow, larger markers, dashed
+            label += f" (coincides with {reading_short(same[row.label])})"
+            ax.plot(np.array(TREND_GAPS) * 1e3, np.array(row.trend()) * 1e3, ls="--", marker=marker, ms=10,
+                    mfc="none", mew=1.5, lw=1.5, label=label, zorder=3)
+        else:
+            ax.plot(np.array(TREND_GAPS) * 1e3, np.array(row.trend()) * 1e3, ls=style, marker=marker, ms=5,
+                    label=label)
     ax.set_xlabel("gap [mm]")
     ax.set_ylabel("max barrel displacement [mm]")
     ax.set_title("Model (ii), m = 1000 kg: each reading of the paper vs gap (Fig. 5 claims a maximum at gap 0)",
@@ -336,6 +391,51 @@ def _mount_force_figure(data: dict, mass: float):
     return fig
 
 
+#: Line style of each kind of energy in the energy figure.
+ENERGY_STYLES = {"kinetic": "-", "stored": "--", "dissipated": "-."}
+
+
+def energy_histories(run) -> list[tuple[str, str, np.ndarray]]:
+    """Every energy history of a run as (kind, name, J over ``run.time``): the kinetic energy of each body, the
+    energy stored in each spring or contact, the energy dissipated by each damper or contact."""
+    out = []
+    for kind, histories in (("kinetic", run.kinetic_energy_histories), ("stored", run.stored_energy_histories),
+                            ("dissipated", run.dissipated_energy_history)):
+        out += [(kind, name, np.asarray(history)) for name, history in histories.items()]
+    return out
+
+
+def _energy_figure(data: dict, mass: float):
+    """Where the firing's energy goes: kinetic, stored and dissipated energy of each element vs time, models
+    (i) and (ii), gap 0; the sum of them all is the initial kinetic energy of the barrel (up to the error)."""
+    from mbs_models.results.plotting import new_figure
+    runs = [data["runs"][(MODEL_I, mass)], data["runs"][(MODEL_II, mass)]]
+    fig, axes = new_figure(2, 1, width=10.0, row_height=3.3, sharex=True)
+    names = sorted({name for run in runs for _, name, _ in energy_histories(run)})
+    colours = {name: _ENERGY_COLOURS[i % len(_ENERGY_COLOURS)] for i, name in enumerate(names)}
+    for ax, run in zip(axes[:, 0], runs):
+        histories = energy_histories(run)
+        for kind, name, history in histories:
+            ax.plot(run.time, history, ls=ENERGY_STYLES[kind], color=colours[name], lw=1.3,
+                    label=f"{name.replace('_', ' ')}: {kind}")
+        total = sum(history for _, _, history in histories)
+        ax.plot(run.time, total, color="k", lw=0.8, ls=":", label=f"sum ({total[0]:.0f} J at t = 0)")
+        ax.set_ylabel("energy [J]")
+        ax.set_title(f"{run.scene.model_label}, m = {mass:g} kg, gap 0", fontsize=10)
+        ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))   # beside the curves, never on them
+    axes[-1, 0].set_xlabel("time [s]")
+    fig.suptitle("Energy per element: kinetic (solid), stored (dashed), dissipated (dash-dot)", fontsize=11)
+    return fig
+
+
+_ENERGY_COLOURS = ("#444444", "#1f77b4", "#2ca02c", "#d62728", "#9467bd", "#ff7f0e", "#8c564b", "#17becf")
+
+
+def energy_figure_mass(data: dict) -> float | None:
+    """The absorber mass of the energy figure: the paper's m = 1000 kg (None when the run has not got it)."""
+    return 1000.0 if 1000.0 in data["options"]["masses"] else None
+
+
 #: (file stem, zero-argument figure builder) of the figures being rendered; forked workers read it
 _PENDING_FIGURES: list[tuple[str, Callable]] = []
 
@@ -366,6 +466,9 @@ def figure_builders(data: dict) -> list[tuple[str, Callable]]:
         ]
     mass = mount_force_mass(data)
     builders.append((f"support_force_m{mass:g}", partial(_mount_force_figure, data, mass)))
+    mass = energy_figure_mass(data)
+    if mass is not None:
+        builders.append((f"energy_m{mass:g}", partial(_energy_figure, data, mass)))
     if data["conventions"]:
         builders.append(("conventions_gap_trend", partial(_convention_figure, data)))
     return builders
@@ -424,18 +527,30 @@ def table2_rows(data: dict) -> list[dict]:
     return rows
 
 
+#: The units the page shows (machine-readable outputs stay SI): SI unit -> (shown unit, factor).
+#: Displacements in mm, forces in kN, in every table, figure and sentence.
+DISPLAY_UNITS = {"m": ("mm", 1e3), "N": ("kN", 1e-3)}
+
+
+def display(value: float | None, unit: str) -> tuple[float | None, str]:
+    """``value`` in SI ``unit`` as the page shows it: (value in the shown unit, shown unit)."""
+    shown, factor = DISPLAY_UNITS.get(unit, (unit, 1.0))
+    return (None if value is None else value * factor), shown
+
+
 def _kn(force: float | None) -> str:
     """A force in N written in kN (a dash when there is none)."""
     return "-" if force is None else f"{force / 1e3:.2f}"
 
 
 def table2_markdown(rows: list[dict]) -> str:
-    lines = [("| model | m [kg] | ours [m] | peak support force [kN] | paper [m] | ours - paper [mm] | rel. diff. | "
+    lines = [("| model | m [kg] | ours [mm] | peak support force [kN] | paper [mm] | ours - paper [mm] | rel. diff. | "
               "engine vs reference |"),
              "|---|---:|---:|---:|---:|---:|---:|---:|"]
     for r in rows:
-        lines.append(f"| {r['model']} | {r['absorber_mass']:g} | {r['engine']:.4f} | {_kn(r['peak_support_force'])} | "
-                     f"{r['paper']:.4f} | {r['difference'] * 1e3:+.2f} | {r['relative_difference'] * 100:+.2f} % | "
+        lines.append(f"| {r['model']} | {r['absorber_mass']:g} | {r['engine'] * 1e3:.2f} | "
+                     f"{_kn(r['peak_support_force'])} | {r['paper'] * 1e3:.1f} | {r['difference'] * 1e3:+.2f} | "
+                     f"{r['relative_difference'] * 100:+.2f} % | "
                      f"{r['engine_vs_reference']:.1e} |")
     return "\n".join(lines) + "\n"
 
@@ -462,11 +577,11 @@ def mount_force_sentences(rows: list[dict]) -> list[str]:
         text = (f"m = {mass:g} kg: {lowest['model']} moderates the force on the mount most, "
                 f"{_kn(lowest['peak_support_force'])} kN ({others})")
         if shortest is lowest:
-            text += f", and also recoils least ({shortest['engine']:.4f} m)."
+            text += f", and also recoils least ({shortest['engine'] * 1e3:.1f} mm)."
         else:
             excess = shortest["peak_support_force"] / lowest["peak_support_force"] - 1
-            text += (f"; {shortest['model']} recoils least, {shortest['engine']:.4f} m against "
-                     f"{lowest['engine']:.4f} m, but pushes {excess * 100:.1f} % harder on the mount.")
+            text += (f"; {shortest['model']} recoils least, {shortest['engine'] * 1e3:.1f} mm against "
+                     f"{lowest['engine'] * 1e3:.1f} mm, but pushes {excess * 100:.1f} % harder on the mount.")
         sentences.append(text)
         lowest_models.add(lowest["model"])
         trade_offs.append(shortest is not lowest)
@@ -493,85 +608,108 @@ def section22_rows(data: dict) -> list[dict]:
     return rows
 
 
-_NOT_STUDIED = ("the readings of the paper and the contact-law calibration were not computed in this run "
+_NOT_STUDIED = ("The readings of the paper and the contact-law calibration were not computed in this run "
                 "(recoil paper --reproduce-only); the full report studies them")
 
 
+def _sentence(text: str) -> str:
+    """``text`` as a sentence: a capital first letter (a symbol such as "m = 100 kg" stays) and a full stop."""
+    text = text.strip()
+    if text and not re.match(r"[a-z] =", text):
+        text = text[0].upper() + text[1:]
+    return text if text.endswith((".", "!", "?")) else text + "."
+
+
+def _law_text(parameters: dict, fixed: dict) -> str:
+    """A contact law's parameters in words: "contact stiffness 3.31e+07 N/m^0.98, ..."."""
+    exponent = parameters.get("exponent", fixed.get("exponent"))
+    parts = []
+    for name, value in parameters.items():
+        words, _, unit = CONTACT_PARAMETERS.get(name, (name.replace("_", " "), "", ""))
+        if name == "stiffness" and exponent is not None:
+            unit = f"N/m^{exponent:.3g}"
+        parts.append(f"{words} {value:.3g}" + (f"\u00a0{unit}" if unit else ""))
+    return ", ".join(parts)
+
+
 def unreproduced(data: dict) -> list[dict]:
-    """Every published number we do not reproduce within :data:`REPRODUCED_WITHIN`, with the likely reason."""
+    """Every published number we do not reproduce within :data:`REPRODUCED_WITHIN`, with the likely reason
+    (``reason``: plain sentences for an engineer, numbers shown as in the report: mm, kN)."""
     conventions = data["conventions"]
     calibration_rows = {(r["model"], r["absorber_mass"]): r for r in data["calibration_table2"]}
     items = []
 
     default_rms = next((row.rms_error() for row in conventions if not row.conventions.active), None)
 
-    def best_reading(errors_of: Callable) -> tuple[str, bool]:
-        """Text about the reading closest to the paper, and whether it reproduces the number."""
+    def best_reading(errors_of: Callable) -> tuple[list[str], bool]:
+        """Sentences about the reading closest to the paper, and whether it reproduces the number."""
         if not conventions:
-            return _NOT_STUDIED, True
+            return [_NOT_STUDIED], True
         closest = min(conventions, key=lambda row: (abs(errors_of(row)), row.label))
         signed = errors_of(closest)
         err = abs(signed)
-        text = f"the closest reading of the paper is '{closest.label}' at {signed * 100:+.1f} %"
+        if not closest.conventions.active:
+            texts = [f"No other reading of the paper comes closer than ours ({percent_text(signed)})"]
+        else:
+            texts = [f"The reading of the paper closest to it ({reading_text(closest.label)}) gives "
+                     f"{percent_text(signed)}"]
         if err <= REPRODUCED_WITHIN and closest.conventions.active and default_rms is not None:
-            text += (f", which reproduces this number but moves the others away (RMS over all published numbers "
-                     f"{closest.rms_error() * 100:.1f} % against {default_rms * 100:.1f} % by default): the paper "
-                     "may have used that reading for this case only")
-        return text, err <= REPRODUCED_WITHIN
+            texts.append(f"That reading reproduces this number but moves the others away (RMS over all published "
+                         f"numbers {closest.rms_error() * 100:.1f}\u00a0% against {default_rms * 100:.1f}\u00a0% with "
+                         "ours): the paper may have used it for this case only")
+        return texts, err <= REPRODUCED_WITHIN
+
+    def item(published_text: str, paper, ours, unit: str, relative, reasons: list[str]) -> dict:
+        return {"published": published_text, "paper": paper, "ours": ours, "unit": unit,
+                "relative_difference": relative, "reason": " ".join(_sentence(r) for r in reasons)}
 
     for row in table2_rows(data):
         if abs(row["relative_difference"]) <= REPRODUCED_WITHIN:
             continue
         key = (row["model"], row["absorber_mass"])
         calibrated = calibration_rows.get(key)
-        text, explained = best_reading(lambda c: c.table2_errors()[key])
-        reason = [text]
+        reason, explained = best_reading(lambda c: c.table2_errors()[key])
         if calibrated:
-            reason.append(f"the contact law calibrated on Section 2.2 gives {calibrated['relative_error'] * 100:+.1f} %")
+            reason.append("The contact law calibrated on Section 2.2 gives "
+                          + percent_text(calibrated["relative_error"]))
         if row["model"] == MODEL_II and row["paper"] == table2()[(SIMPLIFIED, row["absorber_mass"])].value:
-            reason.append("the published value equals the simplified model's exactly, as if the absorber were "
-                          "never hit, which gap 0 cannot give; the paper's own Fig. 6 sentence says model (ii) is "
-                          "lower -- most likely a transcription or set-up error in Table 2")
+            reason.append("The published value equals the simplified model's exactly, as if the absorber were never "
+                          "hit, which gap 0 cannot give; the paper's own Fig. 6 sentence says model (ii) is lower. "
+                          "Most likely a transcription or set-up error in Table 2")
         elif not explained:
-            reason.append("no reading and no contact law closes it, and Table 2 hardly depends on the contact law: "
+            reason.append("No reading and no contact law closes it, and Table 2 hardly depends on the contact law: "
                           "the published value most likely comes from a set-up the paper does not describe")
-        items.append({"published": f"Table 2, {row['model']}, m = {row['absorber_mass']:g} kg", "paper": row["paper"],
-                      "ours": row["engine"], "unit": "m", "relative_difference": row["relative_difference"],
-                      "reason": "; ".join(reason)})
+        items.append(item(f"Table 2, {row['model']}, m = {row['absorber_mass']:g} kg", row["paper"], row["engine"],
+                          "m", row["relative_difference"], reason))
     calibration = data["calibration"]
     for row in section22_rows(data):
         if abs(row["relative_difference"]) <= REPRODUCED_WITHIN:
             continue
         key = (row["model"], row["quantity"])
-        reason = [best_reading(lambda c: c.section22_errors()[key])[0]]
-        if calibration is None:
-            items.append({"published": f"Section 2.2, {row['model']}, {row['quantity'].replace('_', ' ')}",
-                          "paper": row["paper"], "ours": row["ours"], "unit": row["unit"],
-                          "relative_difference": row["relative_difference"], "reason": "; ".join(reason)})
-            continue
-        fitted = next((r for r in calibration.residuals if r.get("quantity") == row["quantity"]
-                       and row["model"] + ":" in r.get("description", "")), None)
-        law = calibration.parameters
-        law_text = ", ".join(f"{k} = {v:.3g}" for k, v in law.items())
-        if fitted is not None and fitted.get("relative_error") is not None:
-            reason.append(f"a contact law fitted to Section 2.2 ({law_text}) reproduces it to "
-                          f"{fitted['relative_error'] * 100:+.2f} %, so the published impact numbers most likely come "
-                          "from other contact parameters than Table 1")
-        items.append({"published": f"Section 2.2, {row['model']}, {row['quantity'].replace('_', ' ')}",
-                      "paper": row["paper"], "ours": row["ours"], "unit": row["unit"],
-                      "relative_difference": row["relative_difference"], "reason": "; ".join(reason)})
+        reason = best_reading(lambda c: c.section22_errors()[key])[0]
+        if calibration is not None:
+            fitted = next((r for r in calibration.residuals if r.get("quantity") == row["quantity"]
+                           and row["model"] + ":" in r.get("description", "")), None)
+            if fitted is not None and fitted.get("relative_error") is not None:
+                law = _law_text(calibration.parameters, calibration.fixed)
+                reason.append(f"A contact law fitted to Section 2.2 ({law}) "
+                              f"reproduces it to {percent_text(fitted['relative_error'], 2)}, so the published impact "
+                              "numbers most likely come from other contact parameters than Table 1's")
+        items.append(item(f"Section 2.2, {row['model']}, {row['quantity'].replace('_', ' ')}", row["paper"],
+                          row["ours"], row["unit"], row["relative_difference"], reason))
     for verdict in data.get("claims", []):
         if verdict.holds is False:
-            reason = verdict.evidence
+            reason = ["Evidence: " + verdict.evidence]
             if verdict.claim.key == "ii_max_at_gap_zero":
                 trend = {row.label: row.trend() for row in conventions}
                 literal = trend.get("literal_gap_sign")
                 if literal:
-                    reason += ("; only the literal gap sign of Eq. (6) (gap acting as an interference) makes the "
-                               f"displacement fall with the gap ({', '.join(f'{x:.4f}' for x in literal)} m at "
-                               f"{', '.join(f'{g * 1e3:g}' for g in TREND_GAPS)} mm), as Fig. 5 claims")
-            items.append({"published": f"claim ({verdict.claim.source}): {verdict.claim.text}", "paper": None,
-                          "ours": None, "unit": "", "relative_difference": None, "reason": reason})
+                    reason.append("Only the reading with the gap's sign as printed in Eq. (6), where the gap acts "
+                                  "as an interference, makes the displacement fall with the gap "
+                                  f"({', '.join(f'{x * 1e3:.1f}' for x in literal)}\u00a0mm at gaps "
+                                  f"{', '.join(f'{g * 1e3:g}' for g in TREND_GAPS)}\u00a0mm), as Fig. 5 claims")
+            items.append(item(f"Claim of {verdict.claim.source}: \u201c{verdict.claim.text}\u201d", None, None, "",
+                              None, reason))
     return items
 
 
@@ -581,12 +719,16 @@ body{font-family:system-ui,-apple-system,Segoe UI,Roboto,sans-serif;max-width:11
 color:#222;line-height:1.45}
 h1{font-size:1.6em}h2{border-bottom:2px solid #ddd;padding-bottom:.2em;margin-top:2em}
 table{border-collapse:collapse;margin:1em 0;font-size:.92em}th,td{border:1px solid #ccc;padding:.3em .6em;
-text-align:right}th{background:#f3f3f3}td.l,th.l{text-align:left}.scroll{max-width:100%;overflow-x:auto}
+text-align:left;vertical-align:top}th{background:#f3f3f3}td.n,th.n{text-align:right}td.n{white-space:nowrap}
+.scroll{max-width:100%;overflow-x:auto}#tab-conventions td:first-child{min-width:14em}
 pre{background:#f7f7f7;padding:.8em;max-width:100%;box-sizing:border-box;overflow-x:auto;font-size:.85em}
 pre.wrap{white-space:pre-wrap;overflow-wrap:anywhere}
 figure{margin:1.2em 0}figure img{max-width:100%;border:1px solid #eee}figcaption{font-size:.9em;color:#555}
 .bad{color:#b00020;font-weight:600}.good{color:#1b7f2a;font-weight:600}.bad,.good{white-space:nowrap}
 .note{background:#fff8e1;padding:.6em 1em;border-left:4px solid #f0c000}
+dl.meta{display:grid;grid-template-columns:max-content 1fr;gap:.15em 1em;font-size:.92em;margin:1em 0}
+dl.meta dt{font-weight:600;color:#555}dl.meta dd{margin:0;overflow-wrap:anywhere}
+#summary{font-size:1.05em;background:#f3f7fb;padding:.7em 1em;border-left:4px solid #4a7fb5}
 @media print{pre{white-space:pre-wrap;overflow-wrap:anywhere}.scroll{overflow:visible}}
 """
 
@@ -595,11 +737,41 @@ def _e(text) -> str:
     return html.escape(str(text))
 
 
-def _table(headers: list[str], rows: list[list], left: int = 1, table_id: str = "") -> str:
+def bind_units(text: str) -> str:
+    """``text`` with a non-breaking space between each number and its unit or % sign (never wrapped apart)."""
+    return re.sub(r"(\d) (%|mm|kN|m/s|ms|kg|J|s|m)(?=[\s,;:.)]|$)", "\\1\u00a0\\2", text)
+
+
+#: A cell that reads as a number: signed decimal or exponent, maybe a unit or "%", or "n / n" (counts).
+_NUMBER = re.compile(r"[+\-\u2212]?(\d+(\.\d*)?|\.\d+)(e[+\-]?\d+)?(\s*(%|[a-zA-Z]{1,3}))?|\d+ / \d+")
+#: A cell with nothing to align (a dash for "none").
+_EMPTY = {"", "-", "\u2013", "\u2014"}
+
+
+def _cell_text(cell: str) -> str:
+    return html.unescape(re.sub(r"<[^>]*>", "", str(cell))).replace("\u00a0", " ").strip()
+
+
+def numeric_columns(rows: list[list]) -> list[bool]:
+    """Which columns hold numbers (right-aligned, never wrapped): those whose every cell but dashes reads
+    as a number.  Text columns are left-aligned."""
+    width = max((len(row) for row in rows), default=0)
+    out = []
+    for i in range(width):
+        texts = [_cell_text(row[i]) for row in rows if i < len(row)]
+        texts = [t for t in texts if t not in _EMPTY]
+        out.append(bool(texts) and all(_NUMBER.fullmatch(t) for t in texts))
+    return out
+
+
+def _table(headers: list[str], rows: list[list], table_id: str = "") -> str:
+    """A table, text columns left-aligned and number columns right-aligned (see :func:`numeric_columns`)."""
     id_attr = f' id="{table_id}"' if table_id else ""
-    head = "".join(f'<th class="l">{_e(h)}</th>' if i < left else f"<th>{_e(h)}</th>" for i, h in enumerate(headers))
-    body = "".join("<tr>" + "".join(f'<td class="l">{c}</td>' if i < left else f"<td>{c}</td>"
-                                    for i, c in enumerate(row)) + "</tr>" for row in rows)
+    numeric = numeric_columns(rows) + [False] * len(headers)
+    cls = lambda i: "n" if numeric[i] else "l"  # noqa: E731
+    head = "".join(f'<th class="{cls(i)}">{_e(h)}</th>' for i, h in enumerate(headers))
+    body = "".join("<tr>" + "".join(f'<td class="{cls(i)}">{c}</td>' for i, c in enumerate(row)) + "</tr>"
+                   for row in rows)
     # wide tables scroll inside their own box on a narrow screen instead of widening the page
     return f"<div class='scroll'><table{id_attr}><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table></div>"
 
@@ -622,7 +794,7 @@ def _pct(value) -> str:
     if value is None:
         return "&ndash;"
     cls = "bad" if abs(value) > REPRODUCED_WITHIN else "good"
-    return f'<span class="{cls}">{value * 100:+.2f} %</span>'
+    return f'<span class="{cls}">{value * 100:+.2f}&nbsp;%</span>'
 
 
 _EQUATIONS = """Simplified model, Eq. (1):   M x_M'' + k x_M + c(x_M') x_M' = 0,   c = 6239 N s/m (x_M' > 0), 14050 N s/m (x_M' < 0)
@@ -674,12 +846,118 @@ def _contents(sections: list[tuple[str, str]]) -> str:
     return f"<nav id='contents' aria-label='Contents'><p><b>Contents</b></p><ol>{items}</ol></nav>"
 
 
+def _provenance_html(fields: dict[str, str]) -> str:
+    """The header: the paper replicated, when and with what the report was made."""
+    items = "".join(f"<dt>{_e(label)}</dt><dd>{'<i>' if key == 'paper' else ''}{_e(fields.get(key, 'unknown'))}"
+                    f"{'</i>' if key == 'paper' else ''}</dd>" for key, label in PROVENANCE_FIELDS)
+    return f"<dl id='provenance' class='meta'>{items}</dl>"
+
+
+def _count(n: int, total: int) -> str:
+    return f"{n} of {total}"
+
+
+def verdict(data: dict) -> str:
+    """The report's verdict in one paragraph of plain text: what is reproduced, what is not, how well the
+    engine agrees with the independent reference."""
+    t2, s22 = table2_rows(data), section22_rows(data)
+    ok = lambda rows: sum(abs(r["relative_difference"]) <= REPRODUCED_WITHIN for r in rows)  # noqa: E731
+    comparisons = data["comparisons"]
+    passed = sum(c["passed"] for c in comparisons)
+    worst = max((x["relative_error"] for c in comparisons for x in c["checks"]
+                 if x.get("relative_error") is not None), default=None)
+    claims = [v for v in data.get("claims", []) if v.holds is not None]
+    text = (f"{_count(ok(t2), len(t2))} maximum barrel displacements of Table 2"
+            + (f" and {_count(ok(s22), len(s22))} first-impact numbers of Section 2.2" if s22 else "")
+            + f" are reproduced within {REPRODUCED_WITHIN * 100:g} % of the published values")
+    if claims:
+        text += f"; {sum(v.holds for v in claims)} of the paper's {len(claims)} qualitative claims hold"
+    text += (f". The engine agrees with the independent reference in {_count(passed, len(comparisons))} cases"
+             + (f" (largest relative error {worst:.1e})" if worst is not None else "") + ".")
+    missed = [r for r in t2 if abs(r["relative_difference"]) > REPRODUCED_WITHIN]
+    if missed:
+        text += (" Not reproduced in Table 2: "
+                 + ", ".join(f"{r['model']} at m = {r['absorber_mass']:g} kg ({percent_text(r['relative_difference'])})"
+                             for r in missed) + ".")
+    missed22 = [r for r in s22 if abs(r["relative_difference"]) > REPRODUCED_WITHIN]
+    if missed22:
+        largest = max(missed22, key=lambda r: abs(r["relative_difference"]))
+        text += (f" Not reproduced in Section 2.2: {_count(len(missed22), len(s22))} numbers, by up to "
+                 f"{percent_text(largest['relative_difference'])}.")
+    failed = [v for v in claims if not v.holds]
+    if failed:
+        text += f" {len(failed)} of the claims do not hold."
+    return text
+
+
+def percent_text(fraction: float, digits: int = 1) -> str:
+    """A signed relative difference in %, with enough decimals not to print a non-zero one as "-0.0 %"
+    (a non-breaking space before the % sign, which never wraps onto its own line)."""
+    value = fraction * 100
+    if value == 0:
+        return "0\u00a0%"
+    while digits < 4 and round(abs(value), digits) == 0:
+        digits += 1
+    if round(abs(value), digits) == 0:
+        return f"{'-' if value < 0 else '+'}less than 0.001\u00a0%"
+    return f"{value:+.{digits}f}\u00a0%"
+
+
+_COLOUR_RULE = (f"<p class='note' id='colour-rule'>Colours: <span class='good'>green</span> marks a number within "
+                f"{REPRODUCED_WITHIN * 100:g} % of the published value, or a check that passes; "
+                "<span class='bad'>red</span> one further off, or a check that fails.</p>")
+
+
+#: The contact law's parameters: (words, symbol, unit).
+CONTACT_PARAMETERS = {"stiffness": ("contact stiffness", "k_c", "N/m^n_c"), "exponent": ("contact exponent", "n_c", ""),
+                      "damping_factor": ("contact damping factor", "lambda_c", "s/m")}
+
+
+def _parameter_name(name: str) -> str:
+    words, symbol, _ = CONTACT_PARAMETERS.get(name, (name.replace("_", " "), "", ""))
+    return f"{words} {symbol}".strip()
+
+
+def _calibration_html(calibration) -> str:
+    """The calibration's fit: outcome, parameters (with standard errors), each number fitted, its cost."""
+    errors = calibration.standard_errors or {}
+    status = calibration.identifiability.get("parameters", {})
+    at_bounds = set(calibration.identifiability.get("at_bounds", []))
+    rows = [[_e(_parameter_name(name)), _fmt(value, 6),
+             _fmt(errors.get(name), 3) if errors.get(name) is not None else "&ndash;",
+             _e(CONTACT_PARAMETERS.get(name, ("", "", ""))[2]),
+             _e(status.get(name, "")) + (" (at the search bound)" if name in at_bounds else "")]
+            for name, value in calibration.parameters.items()]
+    rows += [[_e(_parameter_name(name)), _fmt(value, 6), "&ndash;",
+              _e(CONTACT_PARAMETERS.get(name, ("", "", ""))[2]), "fixed (Table 1)"]
+             for name, value in calibration.fixed.items()]
+    fitted = []
+    for r in calibration.residuals:
+        target, unit = display(r["target"], r["unit"])
+        fitted.append([_e(r["model"]), _e(r["quantity"].replace("_", " ")), _fmt(target, 5),
+                       _fmt(display(r["value"], r["unit"])[0], 5), _fmt(display(r["initial_value"], r["unit"])[0], 5),
+                       _e(unit), _pct(r["relative_error"])])
+    outcome = "converged" if calibration.success else "<span class='bad'>did not converge</span>"
+    return (f"<p>The contact law's parameters fitted to the Section 2.2 numbers (m = 1000 kg) with the independent "
+            f"reference: the fit {outcome} ({_e(calibration.message.replace('.;', ';').replace('`', ''))}).</p>"
+            + _table(["parameter", "fitted value", "standard error", "unit", "identifiable?"], rows,
+                     table_id="tab-calibration-parameters")
+            + _table(["model", "quantity", "paper", "fitted", "with Table 1's law", "unit", "fitted vs paper"], fitted,
+                     table_id="tab-calibration-fit")
+            + f"<p>Cost {calibration.cost:.3g} (with Table 1's law {calibration.initial_cost:.3g}), "
+              f"{calibration.forward_solves} solves, {calibration.wall_time:.1f} s.</p>")
+
+
 def render_html(data: dict, pngs: dict[str, bytes]) -> str:
     """The report as one self-contained HTML page."""
     parts = ["<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
              "<meta name='viewport' content='width=device-width, initial-scale=1'>"
              f"<title>Recoil absorber replication report</title><style>{_CSS}</style></head><body>",
              "<h1>Replication report: recoil mechanism with impact absorbers</h1>",
+             _provenance_html(data.get("provenance") or provenance()),
+             f"<p id='summary'><b>Verdict.</b> {_e(verdict(data))}"
+             + (" Each number not reproduced is listed with its most likely reason under <a href='#unreproduced'>"
+                "Published numbers we cannot reproduce</a>." if data.get("unreproduced") else "") + "</p>",
              "<p>Engine: Exudyn (symbolic user functions, accuracy preset "
              f"<code>{_e(data['options']['accuracy'])}</code>). Independent check: an event-driven scipy solution of "
              "the same equations (<code>validation.reference</code>). Nothing is tuned to the published numbers; where "
@@ -700,17 +978,19 @@ def render_html(data: dict, pngs: dict[str, bytes]) -> str:
     parts.append(f"<pre>{_e(_EQUATIONS)}</pre>")
     # parameters
     parts.append(section("parameters", "Parameters"))
-    rows = [[_e(p.quantity), _e(p.model), _fmt(p.value, 6), _e(p.unit), _e(p.source), _e(p.note)]
+    rows = [[_e(p.quantity.replace("_", " ")), _e(p.model), _fmt(p.value, 6), _e(p.unit), _e(p.source), _e(p.note)]
             for p in published_values() if p.model == "all"]
-    parts.append(_table(["quantity", "model", "value", "unit", "source", "note"], rows, left=2,
+    parts.append(_table(["quantity", "model", "value", "unit", "source", "note"], rows,
                         table_id="tab-parameters"))
     # table 2
     t2 = table2_rows(data)
     parts.append(section("table2", "Table 2: maximum barrel displacement and force on the mount (gap 0, 10 s)"))
-    parts.append(_table(["model", "m [kg]", "ours [m]", "peak support force [kN]", "reference [m]", "paper [m]",
+    parts.append(_COLOUR_RULE)          # the first table with coloured numbers follows
+    parts.append(_table(["model", "m [kg]", "ours [mm]", "peak support force [kN]", "reference [mm]", "paper [mm]",
                          "ours - paper [mm]", "relative", "engine vs reference"],
-                        [[_e(r["model"]), f"{r['absorber_mass']:g}", f"{r['engine']:.5f}", _kn(r["peak_support_force"]),
-                          f"{r['reference']:.5f}", f"{r['paper']:.4f}", f"{r['difference'] * 1e3:+.2f}",
+                        [[_e(r["model"]), f"{r['absorber_mass']:g}", f"{r['engine'] * 1e3:.2f}",
+                          _kn(r["peak_support_force"]), f"{r['reference'] * 1e3:.2f}", f"{r['paper'] * 1e3:.1f}",
+                          f"{r['difference'] * 1e3:+.2f}",
                           _pct(r["relative_difference"]), f"{r['engine_vs_reference']:.1e}"] for r in t2],
                         table_id="tab-table2"))
     parts.append("<p id='mount-force'>Peak support force: the largest magnitude of the force on the mount (what "
@@ -737,12 +1017,22 @@ def render_html(data: dict, pngs: dict[str, bytes]) -> str:
     for mass in data["options"]["masses"]:
         name = f"barrel_displacement_m{mass:g}"
         parts.append(_img(name, pngs[name], f"Barrel displacement, m = {mass:g} kg (paper: Figs 6-8)"))
+    mass = energy_figure_mass(data)
+    if mass is not None:
+        name = f"energy_m{mass:g}"
+        parts.append(f"<p id='energy'>Where the firing's energy goes, m = {mass:g} kg, gap 0: the barrel's initial "
+                     "kinetic energy is passed to the springs and the absorber, and dissipated by the recoil damper, "
+                     "the absorber's damper and the contact at wall A. The dotted line, the sum of all, stays at the "
+                     "initial energy (energy conservation; its drift is the integration error).</p>")
+        parts.append(_img(name, pngs[name], f"Energy per element vs time, models (i) and (ii), m = {mass:g} kg, "
+                                            "gap 0 (not in the paper)"))
     parts.append(section("contact", "Contact force and absorber velocity (Figs 9-11)"))
     s22 = section22_rows(data)
     parts.append(_table(["model", "quantity", "ours", "paper", "unit", "relative", "source"],
-                        [[_e(r["model"]), _e(r["quantity"].replace("_", " ")), _fmt(r["ours"], 5), _fmt(r["paper"], 5),
-                          _e(r["unit"]), _pct(r["relative_difference"]), _e(r["source"])] for r in s22],
-                        left=2, table_id="tab-section22"))
+                        [[_e(r["model"]), _e(r["quantity"].replace("_", " ")),
+                          _fmt(display(r["ours"], r["unit"])[0], 5),
+                          _fmt(display(r["paper"], r["unit"])[0], 5), _e(display(r["paper"], r["unit"])[1]),
+                          _pct(r["relative_difference"]), _e(r["source"])] for r in s22], table_id="tab-section22"))
     for mass in data["options"]["masses"]:
         for stem, caption in (("contact_force", "Contact force (Fig. 9), with the paper's detail windows"),
                               ("absorber_velocity", "Absorber velocity (Fig. 10)"),
@@ -765,8 +1055,13 @@ def render_html(data: dict, pngs: dict[str, bytes]) -> str:
                          "impacts engine / ref.", "verdict"], rows, table_id="tab-engine-vs-reference"))
     # conventions
     parts.append(section("conventions", "Convention study: readings of the paper"))
-    parts.append("<p>Each reading alone (reference values; the engine runs the same scenes). Relative differences "
-                 "to the paper; RMS over the 6 Table 2 cells with an absorber and the 6 Section 2.2 numbers.</p>")
+    parts.append("<p>Each reading of the paper alone, computed with the independent reference (the engine runs the "
+                 "same scenes; its largest relative difference from the reference is in the last column). The "
+                 "columns <i>model (i), 100 kg</i> to <i>model (ii), 1000 kg</i> give the maximum barrel displacement "
+                 "of Table 2 as (ours &minus; paper) / paper; <i>peak contact force</i> and <i>max absorber "
+                 "velocity</i> the same for Section 2.2 (model (i), m = 1000 kg); <i>RMS</i> is over those 6 Table 2 "
+                 "cells and the 6 Section 2.2 numbers; the three <i>gap</i> columns give model (ii)'s maximum barrel "
+                 "displacement at m = 1000 kg, which Fig. 5 says is largest at gap 0.</p>")
     conv_rows = []
     for row in data["conventions"]:
         t2e = row.table2_errors()
@@ -774,31 +1069,39 @@ def render_html(data: dict, pngs: dict[str, bytes]) -> str:
         engine = row.engine_errors()
         failures = sum(1 for v in engine.values() if isinstance(v, str))
         worst = max((v for v in engine.values() if not isinstance(v, str)), default=None)
-        engine_text = (f"max {worst:.1e}" if worst is not None else "") + (
+        engine_text = (f"{worst:.1e}" if worst is not None else "") + (
             f"; <span class='bad'>{failures} cases fail</span> (sticking contact)" if failures else "")
-        conv_rows.append([_e(row.label)]
+        conv_rows.append([f"<b>{_e(reading_short(row.label))}</b><br><small>{_e(reading_text(row.label))} "
+                          f"(option <code>{_e(row.label)}</code>)</small>"]
                          + [_pct(t2e[(m, mass)]) for m in (MODEL_I, MODEL_II) for mass in TABLE2_MASSES]
                          + [_pct(s2e[(MODEL_I, "peak_contact_force")]), _pct(s2e[(MODEL_I, "max_absorber_velocity")]),
-                            f"{row.rms_error() * 100:.1f} %",
-                            ", ".join(f"{x * 1e3:.1f}" for x in row.trend()), engine_text])
+                            f"{row.rms_error() * 100:.1f}&nbsp;%"]
+                         + [f"{x * 1e3:.1f}" for x in row.trend()] + [engine_text])
     not_run = ("<p class='note'>Not computed in this run (<code>recoil paper --reproduce-only</code>); "
                "<code>recoil paper</code> without that option computes it.</p>")
     if data["conventions"]:
-        parts.append(_table(["reading", "(i) 100", "(i) 500", "(i) 1000", "(ii) 100", "(ii) 500", "(ii) 1000",
-                             "F (i)", "v (i)", "RMS", "(ii) x_max at 0/40/80 mm [mm]", "engine vs reference"],
+        parts.append(_table(["reading"] + [f"{m}, {mass:g} kg" for m in (MODEL_I, MODEL_II) for mass in TABLE2_MASSES]
+                            + ["peak contact force, model (i)", "max absorber velocity, model (i)", "RMS"]
+                            + [f"gap {g * 1e3:g} mm [mm]" for g in TREND_GAPS] + ["engine vs reference, largest"],
                             conv_rows, table_id="tab-conventions"))
+        same = coinciding_readings(data["conventions"])
         parts.append(_img("conventions_gap_trend", pngs["conventions_gap_trend"],
-                          "Model (ii) vs gap under each reading"))
+                          "Model (ii), m = 1000 kg: maximum barrel displacement vs gap under each reading"
+                          + "".join(f"; the line of '{reading_short(a)}' coincides with that of '{reading_short(b)}' "
+                                    "(drawn dashed with hollow markers over it): that reading does not change "
+                                    "model (ii)"
+                                    for a, b in same.items())))
     else:
         parts.append(not_run)
     # calibration
     calibration = data["calibration"]
     parts.append(section("calibration", "Contact-law calibration on Section 2.2"))
     if calibration is not None:
-        parts.append(f"<pre class='wrap'>{_e(calibration.summary())}</pre>")  # long lines wrap in the box
-        parts.append(_table(["model", "m [kg]", "predicted x_max [m]", "paper [m]", "relative"],
-                            [[_e(r["model"]), f"{r['absorber_mass']:g}", f"{r['max_barrel_displacement']:.4f}",
-                              _fmt(r["published"]), _pct(r["relative_error"])] for r in data["calibration_table2"]],
+        parts.append(_calibration_html(calibration))
+        parts.append(_table(["model", "m [kg]", "predicted x_max [mm]", "paper [mm]", "relative"],
+                            [[_e(r["model"]), f"{r['absorber_mass']:g}", f"{r['max_barrel_displacement'] * 1e3:.1f}",
+                              "&ndash;" if r["published"] is None else f"{r['published'] * 1e3:.1f}",
+                              _pct(r["relative_error"])] for r in data["calibration_table2"]],
                             table_id="tab-calibration-table2"))
     else:
         parts.append(not_run)
@@ -807,19 +1110,22 @@ def render_html(data: dict, pngs: dict[str, bytes]) -> str:
     parts.append(_table(["claim", "source", "holds?", "evidence"],
                         [[_e(v.claim.text), _e(v.claim.source),
                           "<span class='good'>yes</span>" if v.holds else
-                          ("&ndash;" if v.holds is None else "<span class='bad'>no</span>"), _e(v.evidence)]
-                         for v in data.get("claims", [])], left=4, table_id="tab-claims"))
+                          ("&ndash;" if v.holds is None else "<span class='bad'>no</span>"), _e(bind_units(v.evidence))]
+                         for v in data.get("claims", [])], table_id="tab-claims"))
     # unreproduced
     parts.append(section("unreproduced", "Published numbers we cannot reproduce, and the most likely reason"))
     parts.append(f"<p>Counted as reproduced: within {REPRODUCED_WITHIN * 100:g} % of the published value.</p><ul "
                  "id='unreproduced-list'>")
     for item in data["unreproduced"]:
-        numbers = "" if item["paper"] is None else (
-            f" &mdash; paper {_fmt(item['paper'], 5)} {_e(item['unit'])}, ours {_fmt(item['ours'], 5)} "
-            f"{_e(item['unit'])} ({item['relative_difference'] * 100:+.1f} %)")
-        parts.append(f"<li><b>{_e(item['published'])}</b>{numbers}. {_e(item['reason'])}.</li>")
+        if item["paper"] is None:
+            parts.append(f"<li><b>{_e(item['published'])}</b> {_e(bind_units(item['reason']))}</li>")
+            continue
+        (paper, unit), ours = display(item["paper"], item["unit"]), display(item["ours"], item["unit"])[0]
+        numbers = (f"paper {_fmt(paper, 5)}&nbsp;{_e(unit)}, ours {_fmt(ours, 5)}&nbsp;{_e(unit)} "
+                   f"({_e(percent_text(item['relative_difference']))})")
+        parts.append(f"<li><b>{_e(item['published'])}</b> &mdash; {numbers}. {_e(bind_units(item['reason']))}</li>")
     parts.append("</ul>")
-    timing_rows = [[_e(k), f"{v:.1f} s"] for k, v in data["timings"].items()]
+    timing_rows = [[_e(k), f"{v:.1f}&nbsp;s"] for k, v in data["timings"].items()]
     machine = data.get("machine", {})
     parts.append(section("cost", "What this report cost") + _table(["stage", "wall time"], timing_rows)
                  + (f"<p>{machine.get('cpus')} CPUs, {machine.get('workers')} worker processes, load average "
@@ -863,6 +1169,7 @@ def results_json(data: dict) -> dict:
         "unreproduced": data["unreproduced"],
         "timings": data["timings"],
         "machine": data.get("machine"),
+        "provenance": data.get("provenance"),
     })
 
 
@@ -887,6 +1194,7 @@ def write_report(out: str | Path, options: ReportOptions = ReportOptions(), prog
                       + "".join(f"- {sentence}\n" for sentence in mount_force_sentences(rows)))
     atomic_write_json(out / "table2.json", {"rows": rows, "units": TABLE2_UNITS})
     data["timings"]["total"] = time.perf_counter() - start
+    data["provenance"] = provenance()
     atomic_write_json(out / "results.json", results_json(data))
     atomic_write_text(out / "report.html", render_html(data, pngs))
     return data

@@ -25,6 +25,15 @@ from validation.studies.report import ReportOptions, _sketch, write_report
 DRAWING = set("|/\\-=+[]<>")
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 SUPPORT_FORCE_HEADER = "peak support force [kN]"
+#: The header's fields (label -> what its text must look like): the paper's title, when and with what.
+HEADER_FIELDS = {
+    "Paper replicated": r"analysis of a dynamic system subjected to an impulsive and internal contact force",
+    "Made on": r"\d{4}-\d\d-\d\d \d\d:\d\d( UTC)?",
+    "Package": r"recoil-mbs \d+\.\d+\.\d+\S*",
+    "Commit": r"([0-9a-f]{40}( \(uncommitted changes\))?|unknown)",
+    "Exudyn": r"(\d+\.\d+\S*|unknown)", "numpy": r"(\d+\.\d+\S*|unknown)", "scipy": r"(\d+\.\d+\S*|unknown)",
+    "Machine": r".+, \d+ CPUs",
+}
 
 
 class _Page(HTMLParser):
@@ -38,8 +47,13 @@ class _Page(HTMLParser):
         self.contents_links: list[str] = []          # href of every link in the table of contents
         self.contents_found = False
         self.images: list[str] = []
-        self.tables: list[dict] = []                 # {"section", "headers", "rows"}
+        self.tables: list[dict] = []                 # {"section", "headers", "rows", "classes"}
         self.text: list[str] = []                    # visible text and attribute values but image data
+        self.viewport: str | None = None             # content of <meta name="viewport">
+        self.header: dict[str, str] = {}             # the provenance header: <dt> label -> <dd> text
+        self.order: list[str] = []                   # ids of the summary, contents and sections, in order
+        self._dt: str | None = None
+        self._field: list[str] | None = None
         self._section: str | None = None
         self._after_h3 = False
         self._pre: dict | None = None
@@ -52,6 +66,11 @@ class _Page(HTMLParser):
         self.text += [str(v) for k, v in attrs.items() if k != "src" and v]
         if "id" in attrs:
             self.ids.append(attrs["id"])
+            self.order.append(attrs["id"])
+        if tag == "meta" and attrs.get("name") == "viewport":
+            self.viewport = attrs.get("content", "")
+        if tag in ("dt", "dd"):
+            self._field = []
         if tag == "h2":
             self._section = attrs.get("id")
             self.sections.append(self._section)
@@ -67,15 +86,25 @@ class _Page(HTMLParser):
         if tag == "img":
             self.images.append(attrs.get("src", ""))
         if tag == "table":
-            self.tables.append({"section": self._section, "headers": [], "rows": []})
+            self.tables.append({"section": self._section, "headers": [], "rows": [], "classes": []})
         if tag == "tr" and self.tables:
             self._row = []
+            self.tables[-1]["classes"].append([])
         if tag in ("th", "td"):
             self._cell = []
+            if self.tables and self.tables[-1]["classes"]:
+                self.tables[-1]["classes"][-1].append(attrs.get("class", ""))
         if tag not in ("pre", "h3"):
             self._after_h3 = False          # a sketch is the box right after a model's <h3>
 
     def handle_endtag(self, tag):
+        if tag in ("dt", "dd") and self._field is not None:
+            text = "".join(self._field).strip()
+            if tag == "dt":
+                self._dt = text
+            elif self._dt is not None:
+                self.header[self._dt] = text
+            self._field = None
         if tag == "h3":
             self._after_h3 = True
         if tag == "pre" and self._pre is not None:
@@ -96,6 +125,8 @@ class _Page(HTMLParser):
 
     def handle_data(self, data):
         self.text.append(data)
+        if self._field is not None:
+            self._field.append(data)
         if self._pre is not None:
             self._pre["text"] += data
         if self._cell is not None:
@@ -112,6 +143,28 @@ def _png_size(png: bytes) -> tuple[int, int] | None:
 def _is_drawing(text: str) -> bool:
     lines = [line for line in text.splitlines() if line.strip()]
     return len(lines) >= 3 and sum(ch in DRAWING for ch in text) >= 10
+
+
+#: A cell a reader reads as a number: a signed decimal (maybe with exponent), a unit or % after it.
+_NUMBER_CELL = re.compile(r"[+-]?\d+(\.\d+)?(e[+-]?\d+)?(\u00a0(%|kN|mm|m|s|N))?|\d+ / \d+")
+
+
+def _alignment_problems(table: dict, name: str) -> list[str]:
+    """Number columns right-aligned (class "n"), text columns left-aligned ("l"), "%" bound to its number."""
+    problems = []
+    body = [(row, classes) for row, classes in zip(table["rows"], table["classes"][1:])]
+    for column, header in enumerate(table["headers"]):
+        cells = [(row[column], classes[column]) for row, classes in body if column < len(row)]
+        texts = [text for text, _ in cells if text not in ("", "-", "\u2013")]
+        if any(re.search(r"\d %", text) for text in texts):
+            problems.append(f"{name}, column {header!r}: a '%' after a plain space can wrap onto its own line")
+        numeric = bool(texts) and all(_NUMBER_CELL.fullmatch(text) for text in texts)
+        wanted = "n" if numeric else "l"
+        classes = [table["classes"][0][column]] + [cls for _, cls in cells]
+        if any(wanted not in cls.split() for cls in classes):
+            problems.append(f"{name}, column {header!r}: {'numbers' if numeric else 'text'} not "
+                            f"{'right' if numeric else 'left'}-aligned (classes {sorted(set(classes))})")
+    return problems
 
 
 def page_problems(html_text: str) -> list[str]:
@@ -147,6 +200,24 @@ def page_problems(html_text: str) -> list[str]:
         size = _png_size(png)
         if size is None or min(size) <= 0:
             problems.append(f"image {number} is not a PNG with a size: {src[:40]!r}")
+    # a phone shows the page at its own width
+    if page.viewport is None or "width=device-width" not in page.viewport:
+        problems.append(f"no viewport meta with width=device-width: {page.viewport!r}")
+    # the header: which paper, when, with what
+    for label, pattern in HEADER_FIELDS.items():
+        if not re.fullmatch(pattern, page.header.get(label, ""), re.IGNORECASE):
+            problems.append(f"header field {label!r} is {page.header.get(label)!r}, expected {pattern!r}")
+    # the verdict comes first, before the table of contents and every section
+    if "summary" not in page.order:
+        problems.append("no summary with the verdict (id 'summary')")
+    elif page.order.index("summary") > min((page.order.index(i) for i in ["contents", *page.sections]
+                                            if i in page.order), default=len(page.order)):
+        problems.append("the summary comes after the table of contents or a section")
+    elif "Verdict" not in "".join(page.text):
+        problems.append("the summary gives no verdict")
+    # numbers right-aligned, text left-aligned; a number never wraps away from its unit
+    for number, table in enumerate(page.tables):
+        problems += _alignment_problems(table, f"table {number} ({table['section']})")
     # no reference to a document the reader does not have
     if any("DESIGN.md" in text for text in page.text):
         problems.append("the page cites DESIGN.md")
@@ -185,7 +256,7 @@ def test_report_html_has_every_section_figure_and_table(report_dir):
                   "claims"):
         assert f"tab-{table}" in ids, table
     expected_figures = {"fig4_gap_sweep_model_i", "fig5_gap_sweep_model_ii", "conventions_gap_trend",
-                        "support_force_m1000"} | {
+                        "support_force_m1000", "energy_m1000"} | {
         f"{stem}_m{m}" for stem in ("barrel_displacement", "contact_force", "absorber_velocity", "first_impact")
         for m in (100, 500, 1000)}
     assert {f"fig-{name}" for name in expected_figures} <= ids
@@ -272,7 +343,7 @@ def test_the_mount_force_verdict_follows_table2(report_dir):
     page = _Page()
     page.feed(text)
     table2 = next(t for t in page.tables if t["section"] == "table2")
-    force, x_max = table2["headers"].index(SUPPORT_FORCE_HEADER), table2["headers"].index("ours [m]")
+    force, x_max = table2["headers"].index(SUPPORT_FORCE_HEADER), table2["headers"].index("ours [mm]")
     verdict = re.search(r"<ul id='mount-force-verdict'>(.*?)</ul>", text, re.DOTALL)
     assert verdict, "no verdict on the force on the mount under Table 2"
     sentences = [html.unescape(item) for item in re.findall(r"<li>(.*?)</li>", verdict.group(1))]
@@ -365,15 +436,22 @@ def _tiny_png(width: int = 2, height: int = 1) -> bytes:
 
 
 _SKETCH = "    k\n|--/\\/\\--+-----+\n|        |  M  |\n|--[ c ]-+-----+\nground"
+_HEADER = ("<dl id='provenance'><dt>Paper replicated</dt><dd><i>Analysis of a dynamic system subjected to an "
+           "impulsive and internal contact force</i></dd><dt>Made on</dt><dd>2026-01-02 03:04 UTC</dd>"
+           "<dt>Package</dt><dd>recoil-mbs 0.1.0</dd><dt>Commit</dt><dd>unknown</dd><dt>Exudyn</dt><dd>1.13.6</dd>"
+           "<dt>numpy</dt><dd>2.4.6</dd><dt>scipy</dt><dd>1.17.1</dd><dt>Machine</dt><dd>Linux, x86_64, 2 CPUs</dd>"
+           "</dl><p id='summary'><b>Verdict.</b> all reproduced</p>")
 _GOOD_PAGE = (
-    "<html><body><h1>Report</h1><p>intro</p>"
+    "<html><head><meta name='viewport' content='width=device-width, initial-scale=1'></head><body><h1>Report</h1>"
+    + _HEADER + "<p>intro</p>"
     "<nav id='contents'><ol><li><a href='#models'>Models</a></li><li><a href='#table2'>Table 2</a></li></ol></nav>"
     "<h2 id='models'>1. Models and equations</h2>"
     + "".join(f"<h3>Model {n}</h3><pre>{_SKETCH}</pre>" for n in (1, 2, 3))
     + "<pre>M x'' + k x = 0</pre>"
-    "<h2 id='table2'>2. Table 2</h2><div><table id='tab-table2'><thead><tr><th>model</th><th>m [kg]</th>"
-    "<th>ours [m]</th><th>peak support force [kN]</th></tr></thead><tbody><tr><td>model (i)</td><td>100</td>"
-    "<td>0.22</td><td>6.89</td></tr></tbody></table></div>"
+    "<h2 id='table2'>2. Table 2</h2><div><table id='tab-table2'><thead><tr><th class='l'>model</th>"
+    "<th class='n'>m [kg]</th><th class='n'>ours [mm]</th><th class='n'>peak support force [kN]</th>"
+    "<th class='n'>relative</th></tr></thead><tbody><tr><td class='l'>model (i)</td><td class='n'>100</td>"
+    "<td class='n'>220.1</td><td class='n'>6.89</td><td class='n'>+1.77&nbsp;%</td></tr></tbody></table></div>"
     f"<figure id='fig-x'><img alt='x' src='data:image/png;base64,{base64.b64encode(_tiny_png()).decode()}'>"
     "</figure></body></html>")
 
@@ -398,9 +476,198 @@ def test_page_checker_passes_a_sound_page():
      "not a PNG"),
     (_GOOD_PAGE.replace("data:image/png;base64,", "tiny.png?"), "not a PNG"),
     (_GOOD_PAGE.replace("<p>intro</p>", "<p>see DESIGN.md</p>"), "DESIGN.md"),
-    (_GOOD_PAGE.replace("<th>peak support force [kN]</th>", "<th>peak support force [N]</th>"), "column"),
-    (_GOOD_PAGE.replace("<td>6.89</td>", "<td>&ndash;</td>"), "no positive support force"),
+    (_GOOD_PAGE.replace("<meta name='viewport' content='width=device-width, initial-scale=1'>", ""), "viewport"),
+    (_GOOD_PAGE.replace("<dd>1.17.1</dd>", "<dd></dd>"), "header field 'scipy'"),
+    (_GOOD_PAGE.replace("<dt>Commit</dt><dd>unknown</dd>", ""), "header field 'Commit'"),
+    (_GOOD_PAGE.replace("<dd>unknown</dd>", "<dd>HEAD</dd>"), "header field 'Commit'"),
+    (_GOOD_PAGE.replace("impulsive and internal", "impulsive"), "header field 'Paper replicated'"),
+    (_GOOD_PAGE.replace("<p id='summary'><b>Verdict.</b> all reproduced</p>", ""), "no summary"),
+    (_GOOD_PAGE.replace("<p id='summary'><b>Verdict.</b> all reproduced</p>", "").replace(
+        "<h2 id='table2'>", "<p id='summary'><b>Verdict.</b> all</p><h2 id='table2'>"), "summary comes after"),
+    (_GOOD_PAGE.replace("peak support force [kN]</th>", "peak support force [N]</th>"), "column"),
+    (_GOOD_PAGE.replace("<td class='n'>6.89</td>", "<td class='n'>&ndash;</td>"), "no positive support force"),
+    (_GOOD_PAGE.replace("+1.77&nbsp;%", "+1.77 %"), "'%' after a plain space"),
+    (_GOOD_PAGE.replace("<td class='l'>model (i)</td>", "<td class='n'>model (i)</td>"), "text not left-aligned"),
+    (_GOOD_PAGE.replace("<th class='n'>ours [mm]</th>", "<th>ours [mm]</th>"), "numbers not right-aligned"),
 ])
 def test_page_checker_finds_each_defect(broken, expected):
     problems = page_problems(broken)
     assert any(expected in problem for problem in problems), problems
+
+
+# ------------------------------------------------------------------------------------- percentages
+@pytest.mark.parametrize("fraction, expected", [
+    (-0.0002, "-0.02\u00a0%"), (0.0177, "+1.8\u00a0%"), (-0.25306, "-25.3\u00a0%"), (0.0, "0\u00a0%"),
+    (3e-6, "+0.0003\u00a0%"), (-1e-9, "-less than 0.001\u00a0%"),
+])
+def test_percent_text_never_rounds_a_difference_to_zero(fraction, expected):
+    from validation.studies.report import percent_text
+    assert percent_text(fraction) == expected
+
+
+def test_the_verdict_counts_what_table2_shows(report_dir):
+    text = (report_dir / "report.html").read_text()
+    summary = html.unescape(re.search(r"<p id='summary'>(.*?)</p>", text, re.DOTALL).group(1))
+    page = _Page()
+    page.feed(text)
+    table2 = next(t for t in page.tables if t["section"] == "table2")
+    relative = table2["headers"].index("relative")
+    within = [abs(float(row[relative].replace("\u00a0", " ").split()[0])) <= 1.0 for row in table2["rows"]]
+    assert f"{sum(within)} of {len(within)} maximum barrel displacements of Table 2" in summary, summary
+    comparisons = json.loads((report_dir / "results.json").read_text())["engine_vs_reference"]
+    assert f"in {sum(c['passed'] for c in comparisons)} of {len(comparisons)} cases" in summary, summary
+
+
+# ------------------------------------------------------------------------------------- convention study
+def _reading(label: str, trend_mm: tuple[float, float, float]):
+    from mbs_models import Conventions
+    from validation.studies.conventions import ConventionRow
+
+    flags = {} if label == "default" else {label: True}
+    reference = {("table2", "model (ii)", 1000.0): {"max_barrel_displacement": trend_mm[0] / 1e3},
+                 ("trend", "model (ii)", 0.04): {"max_barrel_displacement": trend_mm[1] / 1e3},
+                 ("trend", "model (ii)", 0.08): {"max_barrel_displacement": trend_mm[2] / 1e3}}
+    return ConventionRow(label, Conventions(**flags), reference, {})
+
+
+def test_convention_figure_shows_every_reading_even_when_two_coincide():
+    import matplotlib.pyplot as plt
+
+    from validation.studies.report import _convention_figure
+
+    rows = [_reading("default", (150.8, 176.0, 190.0)), _reading("v0_includes_absorber", (150.8, 176.0, 190.0)),
+            _reading("literal_gap_sign", (150.8, 100.4, 91.6)), _reading("compression_only", (151.0, 170.0, 185.0))]
+    fig = _convention_figure({"conventions": rows})
+    ax = fig.axes[0]
+    lines = ax.get_lines()
+    assert len(lines) == 4
+    styles = [(line.get_linestyle(), line.get_marker()) for line in lines]
+    assert len(set(styles)) == 4, styles
+    # the reading drawn over another says so in the legend
+    legend = [text.get_text() for text in ax.get_legend().get_texts()]
+    assert sum("coincides" in text for text in legend) == 1
+    assert "coincides with default" in legend[1], legend
+    plt.close(fig)
+
+
+def test_every_reading_has_plain_words():
+    from validation.studies.conventions import CONVENTION_CASES
+    from validation.studies.report import READINGS
+
+    assert {label for label, _ in CONVENTION_CASES} <= set(READINGS)
+    assert all("_" not in text and "_" not in short for text, short in READINGS.values())
+
+
+def test_convention_table_one_number_per_cell_with_units(report_dir):
+    page = _Page()
+    page.feed((report_dir / "report.html").read_text())
+    table = next(t for t in page.tables if t["section"] == "conventions")
+    for model in ("model (i)", "model (ii)"):
+        for mass in ("100", "500", "1000"):
+            assert f"{model}, {mass} kg" in table["headers"], table["headers"]
+    for gap in ("0", "40", "80"):
+        column = table["headers"].index(f"gap {gap} mm [mm]")
+        assert all(re.fullmatch(r"\d+\.\d", row[column]) for row in table["rows"]), [r[column] for r in table["rows"]]
+
+
+# ------------------------------------------------------------------------------- what we cannot reproduce
+def prose_problems(text: str) -> list[str]:
+    """What reads wrong in a paragraph written for an engineer (an empty list: nothing)."""
+    problems = []
+    if ".." in text:
+        problems.append("a doubled full stop")
+    if re.search(r"[+-]0\.0*\s?%", text.replace("\u00a0", " ")):
+        problems.append("a difference printed as zero with a sign (-0.0 %)")
+    identifiers = re.findall(r"\b[a-z][a-z0-9]*(?:_[a-z0-9]+)+\b", text)
+    if identifiers:
+        problems.append(f"internal identifiers in the text: {identifiers}")
+    starts = re.findall(r"[.!?]\s+([a-z]\S*)", text)
+    starts = [word for word in starts if not re.match(r"[a-z]$", word)]   # "m = 100 kg" starts with a symbol
+    if starts:
+        problems.append(f"sentences starting in lower case: {starts}")
+    return problems
+
+
+@pytest.mark.parametrize("text, expected", [
+    ("The gap is zero.. Then", "doubled"), ("It gives -0.0 %.", "zero with a sign"),
+    ("The reading 'v0_includes_absorber' gives", "identifiers"), ("It gives 1 %. the closest", "lower case"),
+])
+def test_prose_checker_finds_each_defect(text, expected):
+    assert any(expected in problem for problem in prose_problems(text)), prose_problems(text)
+
+
+def test_what_we_cannot_reproduce_reads_as_plain_sentences(report_dir):
+    text = (report_dir / "report.html").read_text()
+    listing = re.search(r"<ul id='unreproduced-list'>(.*?)</ul>", text, re.DOTALL).group(1)
+    items = [html.unescape(re.sub(r"<[^>]*>", "", item)) for item in re.findall(r"<li>(.*?)</li>", listing, re.DOTALL)]
+    assert len(items) >= 3
+    assert prose_problems("The closest reading is fine. It gives +0.02 %. m = 100 kg: largest 202.4 mm.") == []
+    for item in items:
+        assert prose_problems(item) == [], item
+
+
+# ------------------------------------------------------------------------------------------ energy figure
+def test_energy_figure_shows_every_element_and_the_sum_stays_the_initial_energy():
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    from mbs_models import model_i, model_ii, simulate
+    from validation.studies.report import ENERGY_STYLES, _energy_figure
+
+    runs = {("model (i)", 1000.0): simulate(model_i(1000.0, 0.0), 10.0, "standard"),
+            ("model (ii)", 1000.0): simulate(model_ii(1000.0, 0.0), 10.0, "standard")}
+    fig = _energy_figure({"runs": runs}, 1000.0)
+    initial = 0.5 * 5600.0 * INITIAL_VELOCITY ** 2          # J, the barrel's kinetic energy after the shot
+    for ax in fig.axes:
+        labels = [line.get_label() for line in ax.get_lines()]
+        for kind in ENERGY_STYLES:
+            assert any(label.endswith(f": {kind}") for label in labels), (kind, labels)
+        for element in ("barrel", "absorber", "recoil spring", "recoil damper", "contact"):
+            assert any(label.startswith(element) for label in labels), (element, labels)
+        total = next(line for line in ax.get_lines() if line.get_label().startswith("sum"))
+        values = np.asarray(total.get_ydata())
+        assert values[0] == pytest.approx(initial, rel=1e-9)
+        assert np.max(np.abs(values - initial)) < 1e-3 * initial
+    plt.close(fig)
+
+
+def test_report_has_the_energy_figure(report_dir):
+    page = _Page()
+    page.feed((report_dir / "report.html").read_text())
+    assert "fig-energy_m1000" in page.ids and "energy" in page.ids
+    assert (report_dir / "energy_m1000.png").read_bytes()[:8] == PNG_SIGNATURE
+
+
+def test_the_page_shows_mm_and_kn_while_the_files_stay_si(report_dir):
+    """Display units are the page's only: table2.json and results.json keep metres and newtons."""
+    table = json.loads((report_dir / "table2.json").read_text())
+    results = json.loads((report_dir / "results.json").read_text())
+    assert table["units"]["engine"] == "m" and table["units"]["peak_support_force"] == "N"
+    assert results["table2"] == table["rows"]
+    for row in table["rows"]:
+        assert 0.1 < row["engine"] < 0.3 and 0.1 < row["paper"] < 0.3          # metres, not millimetres
+        assert 1e3 < row["peak_support_force"] < 1e5                            # newtons, not kilonewtons
+    page = _Page()
+    page.feed((report_dir / "report.html").read_text())
+    shown = next(t for t in page.tables if t["section"] == "table2")
+    ours, force = shown["headers"].index("ours [mm]"), shown["headers"].index(SUPPORT_FORCE_HEADER)
+    for row, cells in zip(table["rows"], shown["rows"]):
+        assert float(cells[ours]) == pytest.approx(row["engine"] * 1e3, abs=0.006)
+        assert float(cells[force]) == pytest.approx(row["peak_support_force"] / 1e3, abs=0.006)
+    for item in results["unreproduced"]:
+        assert item["unit"] in ("m", "N", "m/s", "s", ""), item["unit"]
+
+
+def test_every_image_of_the_page_decodes_to_its_stated_size(report_dir):
+    import io
+
+    import matplotlib.image
+
+    page = _Page()
+    page.feed((report_dir / "report.html").read_text())
+    assert page.images
+    for src in page.images:
+        png = base64.b64decode(src.split(",", 1)[1], validate=True)
+        width, height = _png_size(png)
+        pixels = matplotlib.image.imread(io.BytesIO(png), format="png")
+        assert pixels.shape[:2] == (height, width) and pixels.shape[0] > 100 and pixels.shape[1] > 100

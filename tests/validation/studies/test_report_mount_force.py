@@ -17,9 +17,9 @@ def test_lowest_force_and_the_trade_off_with_the_recoil_length_at_each_mass():
             _row("simplified", 1000.0, 0.22, 7000.0), _row("model (i)", 1000.0, 0.21, 6500.0)]  # (ii) missing
     assert mount_force_sentences(rows) == [
         ("m = 100 kg: model (i) moderates the force on the mount most, 6.00 kN (simplified 7.00 kN, model (ii) "
-         "9.00 kN); model (ii) recoils least, 0.1600 m against 0.2100 m, but pushes 50.0 % harder on the mount."),
+         "9.00 kN); model (ii) recoils least, 160.0 mm against 210.0 mm, but pushes 50.0 % harder on the mount."),
         ("m = 500 kg: model (ii) moderates the force on the mount most, 5.00 kN (simplified 7.00 kN, model (i) "
-         "8.00 kN), and also recoils least (0.1600 m)."),
+         "8.00 kN), and also recoils least (160.0 mm)."),
     ]  # two different models lowest: no sentence for every mass
 
 
