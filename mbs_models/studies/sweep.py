@@ -21,9 +21,10 @@ from __future__ import annotations
 import math
 import multiprocessing
 import os
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import Executor, Future, ProcessPoolExecutor
+from contextlib import contextmanager
 from dataclasses import dataclass
-from typing import Callable, Iterable, Sequence, TypeVar
+from typing import Callable, Iterable, Iterator, Sequence, TypeVar
 
 from ..engine.accuracy import SolverSettings
 from ..errors import SceneError, SimulationError
@@ -88,6 +89,14 @@ def run_scenes(scenes: Sequence[Scene], end_time: float = 10.0, accuracy: str | 
     ``stop_when_final`` is passed to :func:`~mbs_models.simulate`: each run stops once the named
     metrics are proven final (the others are then None in its point).
     """
+    return parallel_map(_run_one, sweep_jobs(scenes, end_time, accuracy, stop_when_final), workers=workers,
+                        progress=progress)
+
+
+def sweep_jobs(scenes: Sequence[Scene], end_time: float = 10.0, accuracy: str | SolverSettings = "standard",
+               stop_when_final: Sequence[str] = ()) -> list[tuple]:
+    """The jobs of :func:`run_scenes` (arguments checked here, so that bad input fails fast); run them with
+    :func:`run_sweep_jobs` -- e.g. in chunks submitted to a pool of :func:`process_pool` beside other work."""
     scenes = list(scenes)
     if not all(isinstance(s, Scene) for s in scenes):
         raise SceneError("scenes", "every item of a sweep must be a Scene")
@@ -101,8 +110,46 @@ def run_scenes(scenes: Sequence[Scene], end_time: float = 10.0, accuracy: str | 
     from ..engine.accuracy import solver_settings_for
     _check_arguments(scenes[0], end_time, 0.0)
     solver_settings_for(accuracy)
+    return jobs
 
-    return parallel_map(_run_one, jobs, workers=workers, progress=progress)
+
+def run_sweep_jobs(jobs: Sequence[tuple]) -> list[SweepPoint]:
+    """One :class:`SweepPoint` per job of :func:`sweep_jobs`, in order, in this process."""
+    return [_run_one(job) for job in jobs]
+
+
+class InlineExecutor(Executor):
+    """An executor that runs each job in this process when it is submitted (``workers=1``)."""
+
+    def submit(self, fn, /, *args, **kwargs) -> Future:
+        future: Future = Future()
+        try:
+            future.set_result(fn(*args, **kwargs))
+        except BaseException as exc:  # noqa: BLE001 - handed to the caller through the future
+            future.set_exception(exc)
+        return future
+
+
+@contextmanager
+def process_pool(workers: int | None = None) -> Iterator[Executor]:
+    """An executor of ``workers`` processes (default: all CPUs; forked where possible, so that workers start
+    in milliseconds with this process's imports), or :class:`InlineExecutor` for ``workers=1``.
+
+    One pool for many kinds of jobs lets independent studies share the CPUs instead of running one phase
+    after the other; jobs start in the order they are submitted.
+    """
+    workers = check_workers(workers)
+    if workers == 1:
+        yield InlineExecutor()
+        return
+    context = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn")
+    with ProcessPoolExecutor(max_workers=workers, mp_context=context,
+                             initializer=exit_with_parent, initargs=(os.getpid(),)) as pool:
+        try:
+            yield pool
+        except BaseException:
+            pool.shutdown(wait=True, cancel_futures=True)
+            raise
 
 
 def parallel_map(function: Callable[[T], R], items: Sequence[T], *, workers: int | None = None,

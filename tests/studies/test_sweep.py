@@ -13,7 +13,8 @@ import mbs_models
 from mbs_models import Conventions, SceneError, model_i, model_ii, simulate
 from mbs_models.studies import point as point_module
 from mbs_models.studies.point import SCALAR_METRICS
-from mbs_models.studies.sweep import gap_sweep, parallel_map, run_scenes, run_sweep
+from mbs_models.studies.sweep import (InlineExecutor, gap_sweep, parallel_map, process_pool, run_scenes, run_sweep,
+                                      run_sweep_jobs, sweep_jobs)
 
 
 def test_parallel_gap_sweep_equals_serial_simulate():
@@ -38,6 +39,31 @@ def test_failed_point_carries_its_reason_and_does_not_stop_the_sweep():
 def test_bad_worker_counts(workers):
     with pytest.raises(SceneError, match="workers"):
         parallel_map(abs, [1, 2], workers=workers)
+    with pytest.raises(SceneError, match="workers"):
+        with process_pool(workers):
+            pass
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_sweep_jobs_in_chunks_on_a_shared_pool_equal_run_scenes(workers):
+    """A sweep cut into chunks and run on a pool beside other jobs gives run_scenes's points, in order."""
+    scenes = [model_i(500.0, gap) for gap in (0.0, 0.02, 0.05)]
+    jobs = sweep_jobs(scenes, 2.0, stop_when_final=("max_barrel_displacement",))
+    with process_pool(workers) as pool:
+        assert isinstance(pool, InlineExecutor) == (workers == 1)
+        other = pool.submit(abs, -3)
+        chunks = [pool.submit(run_sweep_jobs, jobs[i:i + 2]) for i in range(0, len(jobs), 2)]
+        points = [p for chunk in chunks for p in chunk.result()]
+        assert other.result() == 3
+    expected = run_scenes(scenes, 2.0, workers=1, stop_when_final=("max_barrel_displacement",))
+    assert [p.max_barrel_displacement for p in points] == [p.max_barrel_displacement for p in expected]
+    assert [p.gap for p in points] == [0.0, 0.02, 0.05]
+
+
+def test_inline_executor_hands_errors_over_through_the_future():
+    future = InlineExecutor().submit(int, "not a number")
+    with pytest.raises(ValueError):
+        future.result()
 
 
 def test_bad_sweep_arguments_fail_fast():
@@ -45,6 +71,8 @@ def test_bad_sweep_arguments_fail_fast():
         run_scenes([model_i()], end_time=-1.0)
     with pytest.raises(SceneError, match="scenes"):
         run_scenes(["not a scene"])
+    with pytest.raises(SceneError, match="end_time"):
+        sweep_jobs([model_i()], end_time=0.0)
 
 
 def test_progress_is_reported():

@@ -27,6 +27,7 @@ import numpy as np
 from scipy.integrate import OdeSolution, solve_ivp
 
 from .assembly import build_model
+from .dense import DenseSolution
 from .finality import METRICS, Finality, check_names
 from .result import STOP_END_TIME, STOP_METRICS_FINAL, STOP_NO_BOUND, ReferenceImpact, ReferenceResult, ReferenceSegment
 from .switching import Restart, missed_crossing
@@ -58,6 +59,7 @@ def _integrate(rhs, t0: float, t1: float, y0, options: dict, mode):
                                   f"{sol.message}")
     if not np.all(np.isfinite(sol.y)):
         raise ReferenceSolveError(f"non-finite state after t = {t0:.9g} s in {mode}")
+    sol.sol = DenseSolution.of(sol.sol)  # the same values, evaluated on many times at once
     return sol
 
 
@@ -79,7 +81,7 @@ def _refine_last_step(sol, rhs, t1: float, options: dict, mode):
         return sol
     again = _integrate(rhs, t_k, t1, y_k, {**options, "max_step": min(options["max_step"], h)}, mode)
     ts = np.concatenate((sol.sol.ts[:-1], again.sol.ts[1:]))
-    again.sol = OdeSolution(ts, sol.sol.interpolants[:-1] + again.sol.interpolants)
+    again.sol = DenseSolution.of(OdeSolution(ts, sol.sol.interpolants[:-1] + again.sol.interpolants))
     again.t = np.concatenate((sol.t[:-1], again.t[1:]))
     again.y = np.concatenate((sol.y[:, :-1], again.y[:, 1:]), axis=1)
     again.nfev_refinement = again.nfev

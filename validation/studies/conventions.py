@@ -127,16 +127,32 @@ class ConventionRow:
         }
 
 
-def study_conventions(cases=CONVENTION_CASES, *, workers: int | None = None, progress=None) -> list[ConventionRow]:
-    """Run every reading (reference and engine, in parallel) and return one row each."""
+def convention_jobs(cases=CONVENTION_CASES) -> list[tuple[int, tuple, Scene]]:
+    """``(reading index, case key, scene)`` of every run of the study: each scene is run by the reference
+    (:func:`reference_job`) and by the engine (:func:`engine_job`)."""
     jobs: list[tuple[int, tuple, Scene]] = []
     for index, (_, conventions) in enumerate(cases):
         jobs += [(index, key, scene) for key, scene in _cases(conventions).items()]
-    scenes = [scene for _, _, scene in jobs]
-    reference = parallel_map(_reference_job, scenes, workers=workers, progress=named(progress, "reference pass"))
-    engine = parallel_map(_engine_job, scenes, workers=workers, progress=named(progress, "engine pass"))
+    return jobs
+
+
+reference_job, engine_job = _reference_job, _engine_job
+
+
+def convention_rows(cases, jobs, reference: list[dict], engine: list[dict]) -> list[ConventionRow]:
+    """One row per reading from the results of :func:`convention_jobs` (``reference`` and ``engine`` in
+    the jobs' order)."""
     rows = []
     for index, (label, conventions) in enumerate(cases):
         mine = [(key, ref, eng) for (i, key, _), ref, eng in zip(jobs, reference, engine) if i == index]
         rows.append(ConventionRow(label, conventions, {k: r for k, r, _ in mine}, {k: e for k, _, e in mine}))
     return rows
+
+
+def study_conventions(cases=CONVENTION_CASES, *, workers: int | None = None, progress=None) -> list[ConventionRow]:
+    """Run every reading (reference and engine, in parallel) and return one row each."""
+    jobs = convention_jobs(cases)
+    scenes = [scene for _, _, scene in jobs]
+    reference = parallel_map(_reference_job, scenes, workers=workers, progress=named(progress, "reference pass"))
+    engine = parallel_map(_engine_job, scenes, workers=workers, progress=named(progress, "engine pass"))
+    return convention_rows(cases, jobs, reference, engine)

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import base64
 import html
+import importlib
 import math
 import multiprocessing
 import os
@@ -25,6 +26,7 @@ import re
 import textwrap
 import time
 import warnings
+from concurrent.futures import as_completed
 from dataclasses import dataclass, field
 from functools import partial
 from pathlib import Path
@@ -35,14 +37,13 @@ import numpy as np
 from mbs_models import model_i, model_ii, simplified_model, simulate
 from mbs_models.scene.models import model_i as _model_i_doc, model_ii as _model_ii_doc, simplified_model as _simp_doc
 from mbs_models.outputs import atomic_write_json, atomic_write_text, prepare_output_dir
-from mbs_models.results.plotting import (MODEL_COLOURS, figure_png, new_figure, plot_barrel_displacements,
-                                 plot_contact_histories, plot_first_impact)
 from mbs_models.scene import Scene
-from mbs_models.studies.sweep import parallel_map, run_scenes
+from mbs_models.studies.sweep import default_workers, process_pool, run_sweep_jobs, sweep_jobs
 
 from .claims import ClaimEvidence, evaluate_claims
 from .compare import compare
-from .conventions import CONVENTION_CASES, TREND_GAPS, study_conventions
+from .conventions import (CONVENTION_CASES, TREND_GAPS, convention_jobs, convention_rows, engine_job,
+                          reference_job)
 from .paper import MODEL_I, MODEL_II, SIMPLIFIED, TABLE2_MASSES, published, published_values, table2
 from .progress import counter
 from .provenance import FIELDS as PROVENANCE_FIELDS, provenance
@@ -117,26 +118,103 @@ def _counter(progress: Progress, label: str):
     return counter(progress, label)
 
 
+def _timed(function: Callable, *args) -> tuple[float, object]:
+    """``(seconds, function(*args))``: a job of the report's pool with its own run time."""
+    start = time.perf_counter()
+    value = function(*args)
+    return time.perf_counter() - start, value
+
+
+def _calibration_job(parameters: tuple[str, ...], bounds: dict | None) -> tuple[object, list[dict]]:
+    """The contact-law calibration on Section 2.2 and its Table 2 prediction (one job: they run in order)."""
+    from .calibration import paper_section22_calibration, predict_table2
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        calibration = paper_section22_calibration(parameters, bounds=bounds)
+    return calibration, predict_table2(calibration)
+
+
+#: Gap-sweep runs per job of the report's pool (~10 ms each: small jobs even out the workers' ends).
+SWEEP_CHUNK = 12
+
+
+class _Stage:
+    """The jobs of one stage of the report: their results in submission order, progress, run time."""
+
+    def __init__(self, name: str, total: int, progress: Progress):
+        self.name, self.total, self.done, self.seconds = name, total, 0, 0.0
+        self.results: list = [None] * total
+        self.report = _counter(progress, name)
+
+    def finish(self, index: int, seconds: float, value) -> None:
+        self.results[index] = value
+        self.seconds += seconds
+        self.done += 1
+        self.report(self.done, self.total)
+
+
 def compute_report(options: ReportOptions = ReportOptions(), progress: Progress = _silent) -> dict:
-    """Run every computation of the report; return a dict of results (figures are made later)."""
+    """Run every computation of the report; return a dict of results (figures are made later).
+
+    Every run of every stage (engine vs reference, gap sweeps, convention study, calibration) is a job of
+    one pool of ``options.workers`` processes: the stages share the CPUs side by side instead of one after
+    the other, the longest jobs first and the small sweep chunks last so that the workers finish together.
+    ``data["timings"][stage]`` is the run time of the stage's jobs added up over the workers (s).
+    """
     timings: dict[str, float] = {}
     data: dict = {"options": {k: v for k, v in options.__dict__.items()}}
-    from mbs_models.studies.sweep import default_workers
     data["machine"] = {"cpus": os.cpu_count(), "workers": options.workers or default_workers(),
                        "load_average_at_start": round(os.getloadavg()[0], 2) if hasattr(os, "getloadavg") else None}
 
-    start = time.perf_counter()
-    progress("engine vs reference on the paper cases")
     scenes = _comparison_scenes(options)
     if options.comparison_gaps == (0.0, 0.04, 0.08) and options.masses == TABLE2_MASSES:
         assert len(scenes) == 19
-    outputs = parallel_map(_comparison_job, scenes, workers=options.workers,
-                           progress=_counter(progress, "engine vs reference"))
-    data["comparisons"] = [case for case, _ in outputs]
-    timings["engine vs reference"] = time.perf_counter() - start
+    gaps = np.round(np.arange(0.0, options.gap_max + 1e-12, options.gap_step), 6)
+    sweep_scenes = [factory(m, float(g)) for factory in (model_i, model_ii) for m in options.masses for g in gaps]
+    jobs = sweep_jobs(sweep_scenes, options.end_time, options.accuracy, stop_when_final=("max_barrel_displacement",))
+    chunks = [jobs[i:i + SWEEP_CHUNK] for i in range(0, len(jobs), SWEEP_CHUNK)]
+    cases = [c for c in CONVENTION_CASES if options.convention_labels is None or c[0] in options.convention_labels]
+    convention_runs = convention_jobs(tuple(cases)) if options.studies else []
+    convention_scenes = [scene for _, _, scene in convention_runs]
+
+    progress(f"engine vs reference on the paper cases ({len(scenes)}), gap sweeps ({len(gaps)} gaps x "
+             f"{len(options.masses)} masses x 2 models)" + (", convention study and contact-law calibration on "
+                                                            "Section 2.2" if options.studies else ""))
+    # (stage, function, items): submitted in this order, the longest jobs first
+    plan: list[tuple[str, Callable, list]] = []
+    if options.studies:
+        plan.append(("calibration", _calibration_job,
+                     [(options.calibration_parameters, options.calibration_bounds or None)]))
+        plan.append(("convention study (engine)", engine_job, [(s,) for s in convention_scenes]))
+    plan.append(("engine vs reference", _comparison_job, [(s,) for s in scenes]))
+    if options.studies:
+        plan.append(("convention study (reference)", reference_job, [(s,) for s in convention_scenes]))
+    plan.append(("gap sweeps", run_sweep_jobs, [(chunk,) for chunk in chunks]))
 
     start = time.perf_counter()
-    progress("time histories (Figs 6-11)")
+    stages = {name: _Stage(name, len(items), progress) for name, _, items in plan}
+    with process_pool(options.workers) as pool:
+        pending = {}
+        for name, function, items in plan:
+            for index, args in enumerate(items):
+                future = pool.submit(_timed, function, *args)
+                if future.done():  # run in this process (workers=1): report it now
+                    stages[name].finish(index, *future.result())
+                else:
+                    pending[future] = (name, index)
+        # matplotlib is needed for the figures only: import it here while the workers compute (they were
+        # forked without it)
+        importlib.import_module("mbs_models.results.plotting")
+        for future in as_completed(pending):
+            name, index = pending[future]
+            stages[name].finish(index, *future.result())
+    compute_wall = time.perf_counter() - start
+
+    outputs = stages["engine vs reference"].results
+    data["comparisons"] = [case for case, _ in outputs]
+    timings["engine vs reference"] = stages["engine vs reference"].seconds
+
+    start = time.perf_counter()
     # the comparisons ran the gap-0 cases for 10 s at "standard" already: reuse those runs when they match
     compared = {(run.scene.model_label, run.scene.absorber.mass if run.scene.absorber else None): run
                 for _, run in outputs if run is not None}
@@ -154,12 +232,7 @@ def compute_report(options: ReportOptions = ReportOptions(), progress: Progress 
     data["runs"] = runs
     timings["time histories"] = time.perf_counter() - start
 
-    start = time.perf_counter()
-    gaps = np.round(np.arange(0.0, options.gap_max + 1e-12, options.gap_step), 6)
-    progress(f"gap sweeps: {len(gaps)} gaps x {len(options.masses)} masses x 2 models")
-    sweep_scenes = [factory(m, float(g)) for factory in (model_i, model_ii) for m in options.masses for g in gaps]
-    points = run_scenes(sweep_scenes, options.end_time, options.accuracy, workers=options.workers,
-                        progress=_counter(progress, "gap sweeps"), stop_when_final=("max_barrel_displacement",))
+    points = [point for chunk in stages["gap sweeps"].results for point in chunk]
     sweeps: dict[tuple[str, float], list[tuple[float, float]]] = {}
     failures = []
     for point in points:
@@ -169,27 +242,18 @@ def compute_report(options: ReportOptions = ReportOptions(), progress: Progress 
             continue
         sweeps.setdefault(key, []).append((point.gap, point.max_barrel_displacement))
     data["sweeps"], data["sweep_failures"] = sweeps, failures
-    timings["gap sweeps"] = time.perf_counter() - start
+    timings["gap sweeps"] = stages["gap sweeps"].seconds
 
     data["conventions"], data["calibration"], data["calibration_table2"] = [], None, []
     if options.studies:
-        start = time.perf_counter()
-        progress("convention study")
-        cases = [c for c in CONVENTION_CASES if options.convention_labels is None or c[0] in options.convention_labels]
-        data["conventions"] = study_conventions(tuple(cases), workers=options.workers,
-                                                progress=_counter(progress, "convention study"))
-        timings["convention study"] = time.perf_counter() - start
-
-        start = time.perf_counter()
-        progress("contact-law calibration on Section 2.2")
-        from .calibration import paper_section22_calibration, predict_table2
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            calibration = paper_section22_calibration(options.calibration_parameters,
-                                                      bounds=options.calibration_bounds or None)
-        data["calibration"] = calibration
-        data["calibration_table2"] = predict_table2(calibration)
-        timings["calibration"] = time.perf_counter() - start
+        data["conventions"] = convention_rows(tuple(cases), convention_runs,
+                                              stages["convention study (reference)"].results,
+                                              stages["convention study (engine)"].results)
+        timings["convention study"] = (stages["convention study (reference)"].seconds
+                                       + stages["convention study (engine)"].seconds)
+        data["calibration"], data["calibration_table2"] = stages["calibration"].results[0]
+        timings["calibration"] = stages["calibration"].seconds
+    timings["all studies side by side (wall)"] = compute_wall
 
     x_max = {(SIMPLIFIED, m): runs[SIMPLIFIED].max_barrel_displacement for m in TABLE2_MASSES}
     for mass in options.masses:
@@ -206,6 +270,7 @@ def compute_report(options: ReportOptions = ReportOptions(), progress: Progress 
 
 # ------------------------------------------------------------------------------------------- figures
 def _sweep_figure(data: dict, model: str, fig_number: int):
+    from mbs_models.results.plotting import MODEL_COLOURS, new_figure
     fig, axes = new_figure(1, 1, row_height=3.8)
     ax = axes[0, 0]
     colours = {100.0: "#2ca02c", 500.0: "#ff7f0e", 1000.0: "#9467bd"}
@@ -269,6 +334,7 @@ _READING_STYLES = (("-", "o"), ("--", "s"), ("-.", "^"), (":", "D"), ("-", "v"),
 
 
 def _convention_figure(data: dict):
+    from mbs_models.results.plotting import new_figure
     fig, axes = new_figure(1, 1, row_height=3.6)
     ax = axes[0, 0]
     rows = data["conventions"]
@@ -302,6 +368,7 @@ def mount_force_mass(data: dict) -> float:
 
 def _mount_force_figure(data: dict, mass: float):
     """The force on the mount (support force, kN) vs time of the three models at one absorber mass, gap 0."""
+    from mbs_models.results.plotting import MODEL_COLOURS, new_figure
     fig, axes = new_figure(1, 1, row_height=3.6)
     ax = axes[0, 0]
     runs = data["runs"]
@@ -341,6 +408,7 @@ def energy_histories(run) -> list[tuple[str, str, np.ndarray]]:
 def _energy_figure(data: dict, mass: float):
     """Where the firing's energy goes: kinetic, stored and dissipated energy of each element vs time, models
     (i) and (ii), gap 0; the sum of them all is the initial kinetic energy of the barrel (up to the error)."""
+    from mbs_models.results.plotting import new_figure
     runs = [data["runs"][(MODEL_I, mass)], data["runs"][(MODEL_II, mass)]]
     fig, axes = new_figure(2, 1, width=10.0, row_height=3.3, sharex=True)
     names = sorted({name for run in runs for _, name, _ in energy_histories(run)})
@@ -374,11 +442,13 @@ _PENDING_FIGURES: list[tuple[str, Callable]] = []
 
 def _render_pending(index: int) -> bytes:
     """PNG bytes of the ``index``-th pending figure (runs in a forked worker)."""
+    from mbs_models.results.plotting import figure_png
     return figure_png(_PENDING_FIGURES[index][1]())
 
 
 def figure_builders(data: dict) -> list[tuple[str, Callable]]:
     """Every figure of the report as (file stem, zero-argument builder returning a Figure)."""
+    from mbs_models.results.plotting import plot_barrel_displacements, plot_contact_histories, plot_first_impact
     runs = data["runs"]
     builders = [("fig4_gap_sweep_model_i", partial(_sweep_figure, data, MODEL_I, 4)),
                 ("fig5_gap_sweep_model_ii", partial(_sweep_figure, data, MODEL_II, 5))]
@@ -404,6 +474,10 @@ def figure_builders(data: dict) -> list[tuple[str, Callable]]:
     return builders
 
 
+#: File stems of the figures that take longest to render (submitted first).
+_COSTLY_FIGURES = ("contact_force_", "absorber_velocity_")
+
+
 def make_figures(data: dict, workers: int | None = None) -> dict[str, bytes]:
     """Every figure of the report as PNG bytes, keyed by file stem.
 
@@ -412,15 +486,22 @@ def make_figures(data: dict, workers: int | None = None) -> dict[str, bytes]:
     pickled; elsewhere, or with ``workers=1``, the figures are rendered here one by one.
     """
     global _PENDING_FIGURES
+    from mbs_models.results.plotting import figure_png
     builders = figure_builders(data)
     if workers == 1 or "fork" not in multiprocessing.get_all_start_methods():
         return {name: figure_png(build()) for name, build in builders}
     _PENDING_FIGURES = builders
+    # one figure per job, the costliest first (the 2 x 2 panels of Figs 9-10 take ~3x a one-panel figure),
+    # so that the workers finish together
+    order = sorted(range(len(builders)), key=lambda i: not builders[i][0].startswith(_COSTLY_FIGURES))
     try:
-        pngs = parallel_map(_render_pending, range(len(builders)), workers=workers)
+        with process_pool(workers) as pool:
+            futures = {i: pool.submit(_render_pending, i) for i in order}
+            pngs = [futures[i].result() for i in range(len(builders))]
     finally:
         _PENDING_FIGURES = []
     return {name: png for (name, _), png in zip(builders, pngs)}
+
 
 
 # --------------------------------------------------------------------------------------------- tables
@@ -1048,7 +1129,9 @@ def render_html(data: dict, pngs: dict[str, bytes]) -> str:
     machine = data.get("machine", {})
     parts.append(section("cost", "What this report cost") + _table(["stage", "wall time"], timing_rows)
                  + (f"<p>{machine.get('cpus')} CPUs, {machine.get('workers')} worker processes, load average "
-                    f"{machine.get('load_average_at_start')} at the start (other programs share the CPUs). The gap "
+                    f"{machine.get('load_average_at_start')} at the start (other programs share the CPUs). The "
+                    "stages run side by side on the worker processes: a stage's time is that of its runs added "
+                    "up over the workers, the rows marked wall and the total are elapsed times. The gap "
                     "sweeps and the convention study stop each run once its peak metrics are proven final by "
                     "energy bounds (same values as the full 10 s runs); the engine-vs-reference cases and the "
                     "time histories run the full 10 s.</p>" if machine else ""))
@@ -1097,7 +1180,9 @@ def write_report(out: str | Path, options: ReportOptions = ReportOptions(), prog
     data = compute_report(options, progress)
     progress("figures and report")
     data["unreproduced"] = unreproduced(data)
+    figures_start = time.perf_counter()
     pngs = make_figures(data, options.workers)
+    data["timings"]["figures (wall)"] = time.perf_counter() - figures_start
     from mbs_models.outputs import atomic_write_bytes
     for name, png in pngs.items():
         atomic_write_bytes(out / f"{name}.png", png)
