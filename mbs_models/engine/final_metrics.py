@@ -601,6 +601,8 @@ class FinalityTracker:
         self.final: set[str] = set()
         self.final_at: dict[str, float] = {}
         self.done = False
+        #: the requested metrics not final yet (kept by _mark, through which alone :attr:`final` grows)
+        self._pending = list(self.requested)
         self._absorbers = list(range(1, len(self.mechanism.bodies)))
         #: ``(j, F, a, b)`` per contact (index j in :attr:`EnergyBounds.contacts`, its ``python_force_function``, its
         #: ends as :func:`connector_ends` gives them): :meth:`EnergyBounds.contact_force` without the lookups
@@ -629,7 +631,8 @@ class FinalityTracker:
             if name not in self.final:
                 self.final.add(name)
                 self.final_at[name] = float(t)
-        self.done = self.enabled and bool(self.requested) and all(name in self.final for name in self.requested)
+        self._pending = [name for name in self.requested if name not in self.final]
+        self.done = self.enabled and bool(self.requested) and not self._pending
 
     def observe(self, t: float, x, v, *, support: bool | None = None) -> bool:
         """Take the state at time ``t`` (s) into account; return :attr:`done`.
@@ -665,7 +668,8 @@ class FinalityTracker:
         :attr:`EnergyBounds.contacts` order) proves final."""
         if not self.enabled or t < self.after:
             return
-        todo = [name for name in names if name not in self.final]
+        # (the requested names not final yet are kept by _mark: not filtered again at every observed state)
+        todo = self._pending if names is self.requested else [name for name in names if name not in self.final]
         if not todo:
             return
         bounds = self.bounds
@@ -676,8 +680,8 @@ class FinalityTracker:
         # the contact metrics are decided together (as they are cheap together): all of them as soon as
         # any is pending
         contact_metrics = not _CONTACT_METRICS_SET.isdisjoint(todo)  # any of them in todo
-        if contact_metrics:
-            todo += [n for n in _CONTACT_METRICS if n not in self.final and n not in todo]
+        if contact_metrics:  # (a new list: todo may be _pending)
+            todo = todo + [n for n in _CONTACT_METRICS if n not in self.final and n not in todo]
         if contact_metrics or self._reach_moves_well:  # else nothing below reads it (see __init__)
             reachable = [bounds.contact_reachable(j, energy) for j in range(len(bounds.contacts))]
         if "peak_contact_force" in todo or "impacts" in todo:
