@@ -48,8 +48,9 @@ from .mechanism import Mechanism
 MAX_END_TIME = 1.0e4
 #: Re-solves (with max_step / 4 each) when an adaptive solver stepped over a whole contact.
 MAX_CONTACT_RETRIES = 3
-#: The finality tracker (stop_when_final) is shown the state at every this-many-th step: reading the
-#: state costs ~5 us per call in a solve, the bound check ~3-10 us, a step ~5 us.
+#: The finality tracker (stop_when_final) is shown the state at every this-many-th step: an observed step's
+#: pre-step call (reading the state, the bounds) costs ~10 us inside a solve, a step ~5 us (README, cost
+#: section; scripts/bench_prestep.py).  Changing it changes when early stops happen (not bit-identical).
 OBSERVE_EVERY = 4
 #: Most output samples kept for fixed-step solvers (output is thinned beyond this).
 MAX_FIXED_STEP_SAMPLES = 1_000_000
