@@ -14,7 +14,9 @@ shared), runs every point with both, alternating which goes first, and prints
   ratio ref / this;
 * the pre-step function's share of a point: its own time (``perf_counter_ns`` around every call, the
   wrapper's own cost subtracted) over the point's time, in a separate pass (the wrapper slows the run);
-* a check that every result is bit-identical (``end_time``, ``final_metrics``, steps, the displacement).
+* a check that every result is bit-identical (``end_time``, ``final_metrics``, steps, the displacement);
+* the solve alone of a run without the early stop (model (ii), 1000 kg, gap 0, 10 s: the pre-step function is
+  the step budget only) with the ref's pre-step function, this one and none, interleaved, median CPU time.
 
 Not a test: absolute times depend on the machine and its load; the ratio is measured in the same run.
 """
@@ -114,6 +116,38 @@ def wrapper_overhead_ns() -> float:
     return max(wrapped - bare, 0) / n
 
 
+def budget_only_solves(ref, rounds: int) -> dict[str, float]:
+    """Median CPU time (s) of the solve of model (ii) (1000 kg, gap 0, 10 s, ``standard``) with the step budget's
+    pre-step function of ``ref``, of this checkout, and with none; the three interleaved."""
+    import exudyn
+
+    from mbs_models import model_ii
+    from mbs_models.engine import guard, simulation
+    from mbs_models.engine.accuracy import solver_settings_for
+    from mbs_models.engine.assembly import assemble
+
+    ref_guard = sys.modules["mbs_models.engine._ref_guard"]
+    settings = solver_settings_for("standard", "symbolic")
+    installs = {"ref": lambda a: ref._pre_step_function(a, ref_guard.StepBudget(ref_guard.step_budget(10.0)), None),
+                "this": lambda a: simulation._pre_step_function(a, guard.StepBudget(guard.step_budget(10.0)), None),
+                "none": None}
+    cpu = {kind: [] for kind in installs}
+    for r in range(rounds):
+        for kind in (list(installs) if r % 2 else list(installs)[::-1]):
+            assembly = assemble(model_ii(1000.0, 0.0), "symbolic")
+            try:
+                if installs[kind] is not None:
+                    assembly.mbs.SetPreStepUserFunction(installs[kind](assembly))
+                ss = simulation.exudyn_simulation_settings(settings, 10.0)
+                exudyn.config.printToConsole = False
+                start = time.process_time()
+                assembly.mbs.SolveDynamic(ss, solverType=getattr(exudyn.DynamicSolverType, settings.solver))
+                cpu[kind].append(time.process_time() - start)
+            finally:
+                assembly.close()
+    return {kind: statistics.median(values) for kind, values in cpu.items()}
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--against", default="main", help="git ref of the old code (default main)")
@@ -173,6 +207,9 @@ def main(argv=None) -> int:
             print(f"  {kind:>4}: pre-step {1e6 * own / calls:.2f} us per call, {calls} calls, "
                   f"{100 * own / (elapsed[kind] - overhead * calls * 1e-9):.1f} % of the points' CPU time "
                   f"(wrapper {overhead:.0f} ns per call subtracted)")
+    solves = budget_only_solves(ref, 3 * args.rounds)
+    print(f"solve without the early stop (model (ii), 1000 kg, gap 0; step budget only), median of {3 * args.rounds}: "
+          + ", ".join(f"{kind} {1e3 * seconds:.2f} ms" for kind, seconds in solves.items()))
     return 0
 
 
