@@ -424,6 +424,21 @@ class ContactConnector(Connector):
         """The force (N) at one state with the law's current ``v-`` (plain floats)."""
         return self.law(d, rate, PYTHON_OPS)
 
+    def python_force_function(self) -> Callable[[float, float], float]:
+        """:meth:`python_force` with the law's numbers looked up once, for callers that evaluate it at many
+        states (the early stop's tracker): ``f(d, rate)`` in N, the same float as ``python_force(d, rate)``
+        (the same :func:`law_force` call; ``v-`` still read from the capture at each call)."""
+        law, stiffness, exponent, offset = self.law_name, self.contact_stiffness, self.exponent, self.offset
+        damping_factor, damping, compression_only = self.damping_factor, self.contact_damping, self.compression_only
+        capture = self.capture
+
+        def force(d: float, rate: float) -> float:
+            return law_force(d, rate, law, stiffness, exponent, offset, PYTHON_OPS, damping_factor=damping_factor,
+                             damping=damping, compression_only=compression_only,
+                             lam=capture.lam if capture is not None else None)
+
+        return force
+
     def python_elastic(self, d: float) -> float:
         """Elastic energy (J) at ``d`` (plain floats): ``p^(n+1) / ((n+1)/k)`` for p > 0, else 0."""
         p = d - self.offset

@@ -95,6 +95,9 @@ STOP_END_TIME = "end_time"                  # reached the requested end time (no
 STOP_METRICS_FINAL = "metrics_final"        # every metric named in stop_when_final was proven final
 STOP_NO_BOUND = "end_time_no_energy_bound"  # early stop asked, but the scene injects energy (literal_lambda_sign)
 STOP_ENERGY_CHECK = "end_time_energy_check"  # stopped early, but the energy error exceeded the slack: re-solved
+#: The metrics :meth:`FinalityTracker.check` decides together.
+_CONTACT_METRICS = ("peak_contact_force", "impacts", "max_absorber_velocity")
+_CONTACT_METRICS_SET = frozenset(_CONTACT_METRICS)
 #: Eigenvalues of the stiffness form below this fraction of the largest count as zero.
 _RANK_TOLERANCE = 1e-12
 
@@ -127,6 +130,14 @@ def dissipative(scene: Scene | Mechanism) -> bool:
     if scene.conventions.literal_lambda_sign:
         return False
     return math.isfinite((mechanism or Mechanism(scene)).last_input_time)
+
+
+def connector_ends(mechanism: Mechanism, connector) -> tuple[int | None, int | None]:
+    """``(a, b)``: the body indices of a connector's ends, None for the ground, so that
+    ``d = (x[b] if b is not None else 0.0) - (x[a] if a is not None else 0.0)`` is
+    :meth:`Mechanism.relative_at` with the lookups done once."""
+    index = mechanism.body_index
+    return (None if connector.a == GROUND else index[connector.a], None if connector.b == GROUND else index[connector.b])
 
 
 class _QuadraticForm:
@@ -341,6 +352,16 @@ class EnergyBounds:
             general = [c for c in element.connectors
                        if c.stores_energy and not c.is_contact and not c.quadratic_potential]
             self._groups.append((kinetic, springs, contacts, general))
+        #: :meth:`energy`'s terms with their numbers looked up once, element by element (elements without a
+        #: term left out: they add nothing): ``(kinetic, springs, potentials)`` with kinetic ``(i, m_i / 2)``,
+        #: springs ``(a, b, k / 2)`` and potentials ``(a, b, U)`` (the contacts' elastic energy, then the
+        #: other potentials); ``a``, ``b``: :func:`connector_ends`.
+        self._energy_terms = tuple(
+            (tuple((i, self._half_masses[i]) for i in kinetic),
+             tuple(connector_ends(mechanism, c) + (0.5 * c.stiffness,) for c in springs),
+             tuple(connector_ends(mechanism, c) + (c.python_elastic,) for c in contacts)
+             + tuple(connector_ends(mechanism, c) + (c.python_stored_energy,) for c in general))
+            for kinetic, springs, contacts, general in self._groups if kinetic or springs or contacts or general)
         #: the potential well of a connector whose potential is not a quadratic form (None: there is none)
         self.well = PotentialWell.of(mechanism)
         self._barrel_coefficient = form.coefficient(np.eye(len(self.masses))[0]) if self.masses else math.inf
@@ -348,6 +369,10 @@ class EnergyBounds:
         self._contact_coefficients = [form.coefficient(mechanism.direction(c)) for c in self.contacts]
         self._rate_coefficients = [self._rate_coefficient(c) for c in self.contacts]
         self._barrel_stops = [c for c in self.contacts if c.a == GROUND and c.b == mechanism.bodies[0].name]
+        #: the recoil stops outside the potential well (the well's interval bounds the others): barrel_displacement
+        self._barrel_stops_outside_well = [c for c in self._barrel_stops if not self._in_well(c)]
+        #: a potential well of the barrel's (its upper end bounds x_M): barrel_displacement
+        self._well_on_barrel = self.well is not None and self.well.body == 0
         ground = [c for c in mechanism.connectors if GROUND in (c.a, c.b)]
         self._ground = [(c, form.coefficient(mechanism.direction(c)), self._rate_coefficient(c)) for c in ground]
         self._free_oscillators = self._find_free_oscillators(mechanism)
@@ -379,25 +404,23 @@ class EnergyBounds:
         """E in J at the state (body positions m, velocities m/s, in body order).
 
         Summed element by element (an element's bodies and springs first, then its contacts).
+        Every term is evaluated as ``m_i / 2 * v_i * v_i``, ``k / 2 * d * d`` (``d = x_b - x_a``, 0 for the
+        ground), in this order, so that the sum is the same float whatever calls it.
         """
         energy = 0.0
-        mechanism = self.mechanism
-        half = self._half_masses
-        for kinetic, springs, contacts, general in self._groups:
+        for kinetic, springs, potentials in self._energy_terms:
             if kinetic or springs:
                 part = None
-                for i in kinetic:
-                    term = half[i] * v[i] * v[i]
+                for i, half_mass in kinetic:
+                    term = half_mass * v[i] * v[i]
                     part = term if part is None else part + term
-                for c in springs:
-                    d = mechanism.relative_at(c, x)
-                    term = 0.5 * c.stiffness * d * d
+                for a, b, half_stiffness in springs:
+                    d = (x[b] if b is not None else 0.0) - (x[a] if a is not None else 0.0)
+                    term = half_stiffness * d * d
                     part = term if part is None else part + term
                 energy += part
-            for c in contacts:
-                energy += c.python_elastic(mechanism.relative_at(c, x))
-            for c in general:
-                energy += c.python_stored_energy(mechanism.relative_at(c, x))
+            for a, b, potential in potentials:
+                energy += potential((x[b] if b is not None else 0.0) - (x[a] if a is not None else 0.0))
         return energy
 
     # ---------------------------------------------------------------------------- the energy above the floor
@@ -456,10 +479,9 @@ class EnergyBounds:
         """Bound (m) on x_M: the springs', every recoil stop's and a potential well's; inf without any."""
         e = self._excess(energy)
         bound = math.sqrt(self._barrel_coefficient * e)
-        for stop in self._barrel_stops:
-            if not self._in_well(stop):
-                bound = min(bound, stop.offset + stop.penetration_bound(e))
-        if self.well is not None and self.well.body == 0:
+        for stop in self._barrel_stops_outside_well:
+            bound = min(bound, stop.offset + stop.penetration_bound(e))
+        if self._well_on_barrel:
             bound = min(self.well.end(1.0, e), bound)  # (bound is nan for inf * 0: no spring on the barrel, E' = 0)
         return bound
 
@@ -579,7 +601,17 @@ class FinalityTracker:
         self.final: set[str] = set()
         self.final_at: dict[str, float] = {}
         self.done = False
+        #: the requested metrics not final yet (kept by _mark, through which alone :attr:`final` grows)
+        self._pending = list(self.requested)
         self._absorbers = list(range(1, len(self.mechanism.bodies)))
+        #: ``(j, F, a, b)`` per contact (index j in :attr:`EnergyBounds.contacts`, its ``python_force_function``, its
+        #: ends as :func:`connector_ends` gives them): :meth:`EnergyBounds.contact_force` without the lookups
+        self._contact_forces = tuple((j, c.python_force_function()) + connector_ends(self.mechanism, c)
+                                     for j, c in enumerate(self.bounds.contacts))
+        #: :meth:`EnergyBounds.contact_reachable` of a contact in the potential well moves the well's cached
+        #: ends (the start of the next :meth:`PotentialWell.end`): :meth:`check` then evaluates it at every
+        #: call, as always; otherwise (a pure function) only when a contact metric is pending
+        self._reach_moves_well = any(self.bounds._in_well(c) for c in self.bounds.contacts)
         self._needs_support = "peak_support_force" in self.requested
         self._needs_contacts = any(n in self.requested for n in ("peak_contact_force", "impacts"))
         empty = []
@@ -599,7 +631,8 @@ class FinalityTracker:
             if name not in self.final:
                 self.final.add(name)
                 self.final_at[name] = float(t)
-        self.done = self.enabled and bool(self.requested) and all(name in self.final for name in self.requested)
+        self._pending = [name for name in self.requested if name not in self.final]
+        self.done = self.enabled and bool(self.requested) and not self._pending
 
     def observe(self, t: float, x, v, *, support: bool | None = None) -> bool:
         """Take the state at time ``t`` (s) into account; return :attr:`done`.
@@ -610,15 +643,18 @@ class FinalityTracker:
         """
         if x[0] > self.max_barrel_position:
             self.max_barrel_position = x[0]
+        max_velocity = self.max_velocity
         for i in self._absorbers:
-            if v[i] > self.max_velocity[i]:
-                self.max_velocity[i] = v[i]
+            if v[i] > max_velocity[i]:
+                max_velocity[i] = v[i]
         forces = []
-        for j, contact in enumerate(self.bounds.contacts):
-            force = self.bounds.contact_force(contact, x, v)
+        max_contact_force = self.max_contact_force
+        for j, contact_force, a, b in self._contact_forces:  # EnergyBounds.contact_force, inlined
+            force = contact_force((x[b] if b is not None else 0.0) - (x[a] if a is not None else 0.0),
+                                  (v[b] if b is not None else 0.0) - (v[a] if a is not None else 0.0))
             forces.append(force)
-            if force > self.max_contact_force[j]:
-                self.max_contact_force[j] = force
+            if force > max_contact_force[j]:
+                max_contact_force[j] = force
         if self._needs_support if support is None else support:
             magnitude = abs(self.bounds.support_force(x, v))
             if magnitude > self.max_support_force:
@@ -632,7 +668,8 @@ class FinalityTracker:
         :attr:`EnergyBounds.contacts` order) proves final."""
         if not self.enabled or t < self.after:
             return
-        todo = [name for name in names if name not in self.final]
+        # (the requested names not final yet are kept by _mark: not filtered again at every observed state)
+        todo = self._pending if names is self.requested else [name for name in names if name not in self.final]
         if not todo:
             return
         bounds = self.bounds
@@ -642,10 +679,11 @@ class FinalityTracker:
             newly.append("max_barrel_displacement")
         # the contact metrics are decided together (as they are cheap together): all of them as soon as
         # any is pending
-        if any(name in todo for name in ("peak_contact_force", "impacts", "max_absorber_velocity")):
-            todo += [n for n in ("peak_contact_force", "impacts", "max_absorber_velocity")
-                     if n not in self.final and n not in todo]
-        reachable = [bounds.contact_reachable(j, energy) for j in range(len(bounds.contacts))]
+        contact_metrics = not _CONTACT_METRICS_SET.isdisjoint(todo)  # any of them in todo
+        if contact_metrics:  # (a new list: todo may be _pending)
+            todo = todo + [n for n in _CONTACT_METRICS if n not in self.final and n not in todo]
+        if contact_metrics or self._reach_moves_well:  # else nothing below reads it (see __init__)
+            reachable = [bounds.contact_reachable(j, energy) for j in range(len(bounds.contacts))]
         if "peak_contact_force" in todo or "impacts" in todo:
             force_bounds = [bounds.contact_force_bound(j, energy) for j in range(len(bounds.contacts))]
             if all(not reachable[j] or force_bounds[j] <= self.max_contact_force[j] for j in range(len(reachable))):

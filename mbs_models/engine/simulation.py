@@ -48,8 +48,9 @@ from .mechanism import Mechanism
 MAX_END_TIME = 1.0e4
 #: Re-solves (with max_step / 4 each) when an adaptive solver stepped over a whole contact.
 MAX_CONTACT_RETRIES = 3
-#: The finality tracker (stop_when_final) is shown the state at every this-many-th step: reading the
-#: state costs ~5 us per call in a solve, the bound check ~3-10 us, a step ~5 us.
+#: The finality tracker (stop_when_final) is shown the state at every this-many-th step: an observed step's
+#: pre-step call (reading the state, the bounds) costs ~10 us inside a solve, a step ~5 us (README, cost
+#: section; scripts/bench_prestep.py).  Changing it changes when early stops happen (not bit-identical).
 OBSERVE_EVERY = 4
 #: Most output samples kept for fixed-step solvers (output is thinned beyond this).
 MAX_FIXED_STEP_SAMPLES = 1_000_000
@@ -137,25 +138,39 @@ def _pre_step_function(assembly: Assembly, budget: StepBudget | None, tracker: F
     start of every :data:`OBSERVE_EVERY`-th step; the function returns False once every requested metric
     is final: Exudyn then completes that step and stops, so the output ends one step after the state
     that proved finality.
+
+    The function is Python called by Exudyn at every step, so it does at each step only what that step
+    needs, everything else is looked up once here: one step counter serves the budget (which it calls only
+    at :attr:`~mbs_models.engine.guard.StepBudget.next_check`) and the tracker's cadence; the state is read
+    only for the captures or an observed step, and passed on as it is where Exudyn's coordinates are the
+    bodies in body order (else reordered).
     """
     data = assembly.mbs.systemData
+    read_positions, read_velocities = data.GetODE2Coordinates, data.GetODE2Coordinates_t
     mechanism = assembly.mechanism
     order = [assembly.coordinates[body.name] for body in mechanism.bodies]
+    in_body_order = order == list(range(len(order))) and data.ODE2Size() == len(order)
     captures = []
     for contact in mechanism.capturing_contacts:
         ia = None if contact.a == "ground" else assembly.coordinates[contact.a]
         ib = None if contact.b == "ground" else assembly.coordinates[contact.b]
         captures.append((contact.capture, ia, ib))
-    calls = [0]
+    observe = tracker.observe if tracker is not None else None
+    steps = 0  # calls so far (all segments of a run): the budget's step count and the tracker's cadence
+    next_check = budget.next_check if budget is not None else math.inf
     solver = []  # Exudyn's time-integration state, cached on the first call of each solve
 
     def pre_step(mbs, t):
-        if budget is not None and not budget(mbs, t):
-            raise _BudgetSpent(f"step budget spent at t = {t:.6g} s")
+        nonlocal steps, next_check
+        steps += 1
+        if steps >= next_check:  # between checkpoints the budget would only count
+            if not budget.advance(steps, t):
+                raise _BudgetSpent(f"step budget spent at t = {t:.6g} s")
+            next_check = budget.next_check
         q = v = None
         if captures:
-            q = data.GetODE2Coordinates(copy=False).tolist()
-            v = data.GetODE2Coordinates_t(copy=False).tolist()
+            q = read_positions(copy=False).tolist()
+            v = read_velocities(copy=False).tolist()
             if not solver:
                 solver.append(mbs.sys["dynamicSolver"].it)
             t_start = t - solver[0].currentStepSize
@@ -163,16 +178,14 @@ def _pre_step_function(assembly: Assembly, budget: StepBudget | None, tracker: F
                 d = (q[ib] if ib is not None else 0.0) - (q[ia] if ia is not None else 0.0)
                 rate = (v[ib] if ib is not None else 0.0) - (v[ia] if ia is not None else 0.0)
                 capture.observe(t_start, d, rate)
-        if tracker is not None:
-            calls[0] += 1
-            if calls[0] % OBSERVE_EVERY:
-                return True
-            if q is None:
-                q = data.GetODE2Coordinates(copy=False).tolist()
-                v = data.GetODE2Coordinates_t(copy=False).tolist()
-            if tracker.observe(t, [q[i] for i in order], [v[i] for i in order]):
-                return False
-        return True
+        if observe is None or steps % OBSERVE_EVERY:
+            return True
+        if q is None:
+            q = read_positions(copy=False).tolist()
+            v = read_velocities(copy=False).tolist()
+        if in_body_order:
+            return not observe(t, q, v)
+        return not observe(t, [q[i] for i in order], [v[i] for i in order])
 
     pre_step.new_solve = solver.clear  # a segmented run calls it before each segment's solve
     return pre_step

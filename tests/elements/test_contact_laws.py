@@ -297,3 +297,25 @@ def test_fixed_step_solvers_accept_restitution_laws():
                       SolverSettings(solver="RK44", step=2e-5))
     e = (result.absorber_velocity[-1] - result.barrel_velocity[-1]) / IMPACT_VELOCITY
     assert e == pytest.approx(0.5, abs=1e-3)
+
+
+@pytest.mark.parametrize("law, conventions", [(law, None) for law in sorted(CONTACT_LAWS)] + [
+    ("hunt-crossley", Conventions(compression_only=True)), ("hunt-crossley", Conventions(literal_lambda_sign=True))])
+def test_python_force_function_is_python_force(law, conventions):
+    """The early stop's tracker evaluates contacts through python_force_function: the same float as
+    python_force at every state, also after the onset capture changed v-."""
+    from mbs_models.engine.mechanism import Mechanism
+
+    contact = {"hunt-crossley": hunt_crossley(0.6), "hertz": Contact(gap=0.0, stiffness=2.1e8, exponent=1.3, law="hertz"),
+               "kelvin-voigt": Contact(gap=0.0, stiffness=4e7, law="kelvin-voigt", damping=8e4)}.get(
+        law, restitution_law(law, 0.5) if law in RESTITUTION_LAWS else None)
+    scene = model_ii(500.0, 0.002).with_changes(contact=contact, conventions=conventions or Conventions())
+    connector = Mechanism(scene).contacts[0]
+    force = connector.python_force_function()
+    for lam_rate in (0.3, 0.01):
+        if connector.capture is not None:
+            connector.capture.observe(0.0, 0.0, lam_rate)  # apart, approaching at lam_rate: v- changes
+        for d in np.linspace(-0.01, 0.02, 31):
+            for rate in np.linspace(-5.0, 5.0, 41):
+                assert force(float(d), float(rate)) == connector.python_force(float(d), float(rate))
+    assert any(force(0.012, r) > 0.0 for r in (-1.0, 0.0, 1.0))  # the states include contact

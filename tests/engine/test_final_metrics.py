@@ -253,3 +253,43 @@ def test_sweep_with_early_stop_gives_the_same_displacements():
     assert [p.stop_reason for p in early] == ["metrics_final", "metrics_final", "end_time_no_energy_bound"]
     assert early[0].end_time < 2.0 and early[0].impacts is None and early[0].peak_contact_force is None
     assert early[2].end_time == 4.0 and early[2].impacts == full[2].impacts
+
+
+def _stored_scene_names():
+    from mbs_models.scenes import list_scenes
+    return list_scenes()
+
+
+@pytest.mark.parametrize("name", _stored_scene_names())
+def test_energy_is_summed_element_by_element_in_the_documented_order(name):
+    """EnergyBounds.energy looks its terms up once: the same float as the sum written out term by term
+    (every early stop's decision depends on it to the last bit), on every stored scene (every element)."""
+    from mbs_models import load_scene
+    from mbs_models.scenes import scene_path
+
+    b = fm.EnergyBounds(load_scene(scene_path(name)))
+    m = b.mechanism
+    rng = np.random.default_rng(7)
+    for _ in range(200):
+        x = [float(value) for value in rng.normal(0.0, 0.05, len(m.bodies))]
+        v = [float(value) for value in rng.normal(0.0, 2.0, len(m.bodies))]
+        expected = 0.0
+        for element in m.elements:
+            part = None
+            for body in element.bodies:
+                term = 0.5 * body.mass * v[m.body_index[body.name]] * v[m.body_index[body.name]]
+                part = term if part is None else part + term
+            for c in element.connectors:
+                if c.stores_energy and not c.is_contact and c.quadratic_potential:
+                    d = m.relative_at(c, x)
+                    term = 0.5 * c.stiffness * d * d
+                    part = term if part is None else part + term
+            if part is not None:
+                expected += part
+            for c in element.connectors:
+                if c.is_contact:
+                    expected += c.python_elastic(m.relative_at(c, x))
+            for c in element.connectors:
+                if c.stores_energy and not c.is_contact and not c.quadratic_potential:
+                    expected += c.python_stored_energy(m.relative_at(c, x))
+        assert b.energy(x, v) == expected
