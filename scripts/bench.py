@@ -403,15 +403,20 @@ def main(argv=None) -> int:
             if baseline is None:
                 say(f"no git history: the code before issue #11 ({throughput.BASELINE_REV}) is not measured")
             if not args.skip_sweeps:
-                variants = [("before", baseline, 1, "local"), ("now", ROOT, 1, "local"), ("now 2 workers", ROOT, 2, "local")]
+                full_gaps = max(2, args.gap_count // 4)
+                variants = [("before", baseline, 1, "local", False), ("now", ROOT, 1, "local", False),
+                            ("now 2 workers", ROOT, 2, "local", False)]
                 if throughput.dask_available():
-                    variants.append(("dask LocalCluster 2 workers", ROOT, 2, "local-cluster"))
+                    variants.append(("dask LocalCluster 2 workers", ROOT, 2, "local-cluster", False))
+                variants += [(f"full runs, before", baseline, 1, "local", True),
+                             (f"full runs, now", ROOT, 1, "local", True)]
                 runs: dict[str, list[dict]] = {}
                 for round_ in range(args.sweep_rounds):  # alternating: a shared machine's load drifts into all alike
-                    for name, tree, workers, kind in variants:
+                    for name, tree, workers, kind, full in variants:
                         if tree is not None:
                             say(f"sweep: Figs 4/5 grid, {name} (round {round_ + 1} of {args.sweep_rounds})")
-                            runs.setdefault(name, []).append(throughput.sweep_once(tree, workers, kind, args.gap_count))
+                            runs.setdefault(name, []).append(throughput.sweep_once(
+                                tree, workers, kind, full_gaps if full else args.gap_count, full))
                 sweeps = {name: min(outs, key=lambda out: out["wall"]) for name, outs in runs.items()}
                 if args.gap_count == throughput.GAP_COUNT:
                     import bench_reuse
@@ -503,8 +508,11 @@ def main(argv=None) -> int:
         for name, out in sweeps.items():
             print(f"   {name:30s} {out['points'] / out['wall']:7.1f} points/s  [{out['wall']:.1f} s wall, "
                   f"{out['cpu']:.1f} s CPU in the parent]")
-        values = [out["values"] for out in sweeps.values()]
-        print(f"   every variant gives the same displacements: {all(v == values[0] for v in values)}")
+        early = [out["values"] for name, out in sweeps.items() if not name.startswith("full")]
+        full = [out["values"] for name, out in sweeps.items() if name.startswith("full")]
+        print(f"   (\"full runs\": every 4th gap, complete 10 s runs with every metric, as `recoil sweep` runs by default)")
+        print(f"   every variant gives the same displacements: "
+              f"{all(v == early[0] for v in early) and all(v == full[0] for v in full)}")
         if reuse is not None:
             print(f"   in one process, serial: one reused Simulator / a fresh simulate per point: x{reuse['ratio']:.2f} "
                   f"[{reuse['points'] / reuse['fresh_s']:.1f} vs {reuse['points'] / reuse['reuse_s']:.1f} points/s]")
@@ -522,7 +530,10 @@ def main(argv=None) -> int:
         rows.append(("LSODA / complete run (equal accuracy)", lsoda[2] / t_standard, ">= 4", lsoda[2] / t_standard >= 4))
     if "before" in sweeps and "now" in sweeps:
         gain = sweeps["before"]["wall"] / sweeps["now"]["wall"]
-        rows.append(("Figs 4/5 sweep, points/s now / before", gain, ">= 2", gain >= 2))
+        rows.append(("Figs 4/5 sweep (early stop), points/s now / before", gain, ">= 2", gain >= 2))
+    if "full runs, before" in sweeps and "full runs, now" in sweeps:
+        gain = sweeps["full runs, before"]["wall"] / sweeps["full runs, now"]["wall"]
+        rows.append(("sweep of complete runs, points/s now / before", gain, ">= 2", gain >= 2))
     if "now 2 workers" in sweeps and "now" in sweeps:
         gain = sweeps["now"]["wall"] / sweeps["now 2 workers"]["wall"]
         rows.append(("sweep, 2 workers / 1 worker", gain, ">= 1.8", gain >= 1.8))

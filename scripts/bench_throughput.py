@@ -31,11 +31,11 @@ GAP_COUNT = 121  # 0 .. 120 mm in 1 mm steps: with 2 models x 3 masses, the repo
 _SWEEP_CODE = r"""
 import json, sys, time, warnings
 warnings.simplefilter("ignore")
-workers, scheduler, gap_count = int(sys.argv[1]), sys.argv[2], int(sys.argv[3])
+workers, scheduler, gap_count, full = int(sys.argv[1]), sys.argv[2], int(sys.argv[3]), sys.argv[4] == "full"
 masses = %r
 gaps = [round(i * 0.12 / (gap_count - 1), 6) for i in range(gap_count)]
 from mbs_models import model_i, model_ii
-early = ("max_barrel_displacement",)
+early = () if full else ("max_barrel_displacement",)
 try:
     from mbs_models.studies.sweep import run_scenes as run
 except ImportError:
@@ -83,9 +83,13 @@ def _python(tree: Path, arguments: list[str], cwd: Path | None = None) -> subpro
                           cwd=str(cwd or tree), check=True)
 
 
-def sweep_once(tree: Path, workers: int, scheduler: str = "local", gap_count: int = GAP_COUNT) -> dict:
-    """One Figs 4/5 sweep with the code in ``tree``: {"wall", "cpu" (s, this process only), "points", "values"}."""
-    out = _python(tree, ["-c", _SWEEP_CODE, str(workers), scheduler, str(gap_count)]).stdout
+def sweep_once(tree: Path, workers: int, scheduler: str = "local", gap_count: int = GAP_COUNT,
+               full: bool = False) -> dict:
+    """One Figs 4/5 sweep with the code in ``tree``: {"wall", "cpu" (s, this process only), "points", "values"}.
+    ``full``: complete 10 s runs with every metric (as ``recoil sweep`` does by default) instead of the
+    report's early stop on the max barrel displacement."""
+    out = _python(tree, ["-c", _SWEEP_CODE, str(workers), scheduler, str(gap_count),
+                         "full" if full else "early"]).stdout
     return json.loads(out.strip().splitlines()[-1])
 
 

@@ -168,7 +168,8 @@ def parallel_map(function: Callable[[T], R], items: Sequence[T], *, workers: int
             if progress:
                 progress(i + 1, len(items))
         return out
-    chunk = max(1, math.ceil(len(items) / (workers * 8)))
+    # small chunks: the last one is run by one worker while the others idle (32 per worker: < 1/32 of the work)
+    chunk = max(1, math.ceil(len(items) / (workers * 32)))
     context = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn")
     with ProcessPoolExecutor(max_workers=min(workers, len(items)), mp_context=context,
                              initializer=exit_with_parent, initargs=(os.getpid(),)) as pool:
