@@ -30,10 +30,26 @@ import math
 
 import numpy as np
 
+def _ratio_power(numerator: float, denominator: float, exponent: float) -> float:
+    """``(numerator / denominator) ** exponent`` for a positive ``denominator``, else inf (a state no physical
+    motion reaches, e.g. a gas spring compressed beyond its volume: the solver rejects a trial step there,
+    where Python's power of a negative ratio would be a complex number)."""
+    return (numerator / denominator) ** exponent if denominator > 0.0 else math.inf
+
+
+def _ratio_power_array(numerator, denominator, exponent):
+    """:func:`_ratio_power` elementwise."""
+    denominator = np.asarray(denominator, dtype=float)
+    positive = denominator > 0.0
+    safe = np.where(positive, denominator, 1.0)
+    return np.where(positive, (numerator / safe) ** exponent, np.inf)
+
+
 _NAMESPACES = {
-    "rhs": {"copysign": math.copysign, "array": np.array, "full": np.full, "inf": math.inf},
-    "scalar": {"copysign": math.copysign},
-    "array": {"copysign": np.copysign},
+    "rhs": {"copysign": math.copysign, "array": np.array, "full": np.full, "inf": math.inf,
+            "ratio_power": _ratio_power},
+    "scalar": {"copysign": math.copysign, "ratio_power": _ratio_power},
+    "array": {"copysign": np.copysign, "ratio_power": _ratio_power_array},
 }
 
 

@@ -13,9 +13,12 @@ import pytest
 from mbs_models.elements import ELEMENT_TABLES
 from mbs_models.scene import (Absorber, Barrel, Contact, Conventions, Firing, RecoilDamper, RecoilSpring, Scene,
                               model_i, model_ii, simplified_model)
+from mbs_models.scene import load_scene
+from mbs_models.scenes import scene_path
 from validation.reference import ReferenceModelError, solve_reference
 from validation.reference.assembly import build_model
 from validation.reference.model import Mode
+from validation.reference.switching import Restart
 from validation.reference.terms import TERMS
 from validation.reference.terms.contact_laws import ContactMode
 
@@ -182,6 +185,33 @@ def test_rhs_overflow_gives_inf_like_numpy():
     mode = Mode(model.names, (None, True, None, ContactMode("on", True, False, 0.6, 0.69)))
     dy = model.rhs(mode)(0.0, np.array([1e200, 1e200, -1e200, 0.0, 0.0, 0.0, 0.0]))
     assert dy.shape == (7,) and not np.all(np.isfinite(dy))
+
+
+def test_a_gas_spring_beyond_its_volume_gives_inf_not_a_complex_force():
+    """A rejected trial step can also push a gas spring beyond its gas volume (V0 - A d <= 0): the power of
+    the negative ratio would be complex (Python floats) and its real part a finite, wrong force that the
+    integrator might accept; the right-hand side gives inf there (so the step shrinks), and the ordinary
+    state is untouched."""
+    import warnings
+
+    scene = load_scene(scene_path("recuperator"))
+    model = build_model(scene)
+    gas = next(c for c in model.connectors if c.name == "recuperator")
+    y = model.initial_state()
+    mode = Restart(model, 0.0, y, {}, None).mode  # the battery stop holding the preloaded barrel
+    barrel = model.body_index["barrel"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        beyond = y.copy()
+        beyond[2 * barrel] = 1.5 * gas.d_limit
+        dy = model.rhs(mode)(0.0, beyond)
+        assert dy.dtype == float and not np.all(np.isfinite(dy))
+        inside = y.copy()
+        inside[2 * barrel] = 0.5 * gas.d_limit
+        force = model.evaluate(mode, inside).forces[gas.index]
+        assert force == gas.static_force(0.5 * gas.d_limit)  # the same arithmetic as the term's own law
+        batch = model.evaluate(mode, np.stack([inside, beyond], axis=1)).forces[gas.index]
+        assert batch[0] == force and batch[1] == math.inf
 
 
 # ------------------------------------------------------------------ equivalences

@@ -53,8 +53,11 @@ class GasSpring(Connector):
         self.d_limit = self.volume / self.area
 
     def equations(self, state) -> Equations:
-        """``F = p0 A (V0 / (V0 - A d))^n``; no dissipated power."""
-        return Equations("{F} = {preload} * ({V0} / ({V0} - {A} * ({xb} - {xa}))) ** {n}",
+        """``F = p0 A (V0 / (V0 - A d))^n``; no dissipated power.  A trial state of the solver beyond the gas
+        volume (``V0 - A d <= 0``, never an accepted one: the scene's checks keep the stroke inside it) gets an
+        infinite force, so that the step is rejected, instead of the complex power of a negative ratio."""
+        return Equations("""
+            {F} = {preload} * ratio_power({V0}, {V0} - {A} * ({xb} - {xa}), {n})""",
                          dict(preload=self.preload, V0=self.volume, A=self.area, n=self.exponent))
 
     def _ratio(self, d):
