@@ -57,6 +57,8 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # bench_throughput, bench_reuse
 
+from bench_reuse import rss_bytes  # noqa: E402
+
 C_SOURCE = Path(__file__).resolve().parent / "recoil_dopri5.c"
 
 
@@ -226,16 +228,6 @@ def element_costs(scene, end_time: float, repeats: int) -> tuple[dict, dict]:
 
 
 # ------------------------------------------------------------------------------------------------ memory
-
-def rss_bytes() -> int:
-    """Resident set size of this process in bytes (Linux /proc; else peak RSS from getrusage)."""
-    try:
-        with open("/proc/self/statm") as stream:
-            return int(stream.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
-    except OSError:
-        import resource
-        return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
-
 
 def memory_test(scene, runs: int, end_time: float, progress) -> list[tuple[int, int]]:
     """RSS after each tenth of ``runs`` consecutive ``simulate`` calls: [(runs done, bytes)]."""

@@ -67,21 +67,27 @@ def fingerprint(result) -> tuple:
             result.time_of_max_barrel_displacement, result.stop_reason)
 
 
+def timing_wrapper(inner, totals: list):
+    """``inner(mbs, t)`` wrapped so that each call's time adds to ``totals[0]`` (ns) and counts in ``totals[1]``."""
+
+    def pre_step(mbs, t):
+        start = time.perf_counter_ns()
+        try:
+            return inner(mbs, t)
+        finally:
+            totals[0] += time.perf_counter_ns() - start
+            totals[1] += 1
+
+    return pre_step
+
+
 def timed_pre_step(module, totals: list):
     """Wrap ``module._pre_step_function`` so that every call's time adds to ``totals[0]`` (ns)."""
     original = module._pre_step_function
 
     def factory(*args):
         inner = original(*args)
-
-        def pre_step(mbs, t):
-            start = time.perf_counter_ns()
-            try:
-                return inner(mbs, t)
-            finally:
-                totals[0] += time.perf_counter_ns() - start
-                totals[1] += 1
-
+        pre_step = timing_wrapper(inner, totals)
         pre_step.new_solve = inner.new_solve
         return pre_step
 
@@ -96,13 +102,7 @@ def wrapper_overhead_ns() -> float:
     def inner(mbs, t):
         return True
 
-    def pre_step(mbs, t):
-        start = time.perf_counter_ns()
-        try:
-            return inner(mbs, t)
-        finally:
-            totals[0] += time.perf_counter_ns() - start
-            totals[1] += 1
+    pre_step = timing_wrapper(inner, totals)
 
     n = 200_000
     start = time.perf_counter_ns()

@@ -1,6 +1,6 @@
 """Batched nested-grid searches (mbs_models.results.nested_grids) against the one-bracket searches they replace.
 
-``one_bracket_maximum`` and ``one_bracket_crossing`` are the scalar searches as the post-processing ran
+``one_bracket_maximum`` (here) and ``one_bracket_crossing`` (a fixture of conftest.py) are the scalar searches as the post-processing ran
 them before issue #11 (copied here as the reference): the batched searches must give the same bits.
 """
 
@@ -39,16 +39,6 @@ def one_bracket_maximum(f, lo, hi, points=65, levels=4):
     return best_value, best_time
 
 
-def one_bracket_crossing(indicator, a, b, points=129, levels=4):
-    for _ in range(levels):
-        grid = np.linspace(a, b, points)
-        flags = np.asarray(indicator(grid), dtype=bool)
-        flags[-1] = True
-        j = int(np.argmax(flags[1:])) + 1
-        a, b = grid[j - 1], grid[j]
-    return float(0.5 * (a + b))
-
-
 def wiggly(t):
     """A smooth function with many local maxima (s -> arbitrary units)."""
     return np.sin(37.0 * t) + 0.3 * np.cos(211.0 * t + 0.4) + 0.05 * np.sin(1723.0 * t)
@@ -84,7 +74,7 @@ def test_function_maxima_find_a_known_peak():
     np.testing.assert_allclose(values, 0.0, atol=1e-15)
 
 
-def test_first_true_equals_the_one_bracket_search(brackets):
+def test_first_true_equals_the_one_bracket_search(brackets, one_bracket_crossing):
     lo, hi = brackets
     indicator = lambda t: wiggly(t) > 0.2
     found = first_true(indicator, lo, hi)

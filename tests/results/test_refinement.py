@@ -30,18 +30,7 @@ def solved(scene, end_time):
     return seen["mechanism"], seen["samples"]
 
 
-def one_bracket_crossing(indicator, a, b, points=129, levels=4):
-    """The scalar search the post-processing ran before issue #11 (the reference)."""
-    for _ in range(levels):
-        grid = np.linspace(a, b, points)
-        flags = np.asarray(indicator(grid), dtype=bool)
-        flags[-1] = True
-        j = int(np.argmax(flags[1:])) + 1
-        a, b = grid[j - 1], grid[j]
-    return float(0.5 * (a + b))
-
-
-def test_an_episode_lifted_over_the_threshold_by_its_refined_peak_gets_refined_bounds():
+def test_an_episode_lifted_over_the_threshold_by_its_refined_peak_gets_refined_bounds(one_bracket_crossing):
     """Its bounds are searched after the peaks (the second round): the same bits as when its samples
     alone make it an impact, and as the one-bracket search."""
     mechanism, s = solved(model_ii(1000.0, 0.0), 2.0)
