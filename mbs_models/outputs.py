@@ -11,7 +11,7 @@ import json
 import os
 import tempfile
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 from .errors import SceneError
 
@@ -62,10 +62,12 @@ def check_output_file(path: str | Path, key: str) -> Path:
     return path
 
 
-def atomic_write_bytes(path: str | Path, data: bytes) -> Path:
-    """Write ``data`` to ``path`` via a temporary file in the same directory and an atomic rename.
+def atomic_write_with(path: str | Path, write: Callable[[Path], None]) -> Path:
+    """Let ``write(temporary_path)`` write the file, then rename it to ``path`` atomically (a temporary name in the
+    same directory: a reader never sees half a file; on any error nothing is left behind).
 
-    The file's mode is ``0666 & ~umask``, as ``open(path, "wb")`` would give it.
+    The file's mode is ``0666 & ~umask``, as ``open(path, "w")`` would give it (``write`` may be any writer that
+    takes a path: ``DataFrame.to_csv``, ``to_parquet``, ``Figure.savefig``).
     """
     path = Path(path)
     directory = path.parent if str(path.parent) else Path(".")
@@ -74,9 +76,10 @@ def atomic_write_bytes(path: str | Path, data: bytes) -> Path:
     except OSError as exc:
         raise SceneError(str(path), f"cannot write: {exc.strerror or exc}") from None
     try:
-        with os.fdopen(handle, "wb") as stream:
-            os.fchmod(stream.fileno(), 0o666 & ~current_umask())
-            stream.write(data)
+        os.fchmod(handle, 0o666 & ~current_umask())
+        os.close(handle)
+        write(Path(temporary))
+        os.chmod(temporary, 0o666 & ~current_umask())  # a writer that re-created the file
         os.replace(temporary, path)
     except BaseException:
         try:
@@ -85,6 +88,11 @@ def atomic_write_bytes(path: str | Path, data: bytes) -> Path:
             pass
         raise
     return path
+
+
+def atomic_write_bytes(path: str | Path, data: bytes) -> Path:
+    """Write ``data`` to ``path`` atomically (:func:`atomic_write_with`), mode ``0666 & ~umask``."""
+    return atomic_write_with(path, lambda temporary: temporary.write_bytes(data))
 
 
 def atomic_write_text(path: str | Path, text: str) -> Path:

@@ -20,7 +20,6 @@ from __future__ import annotations
 import io
 import json
 import os
-import tempfile
 import time
 from pathlib import Path
 from typing import Any, Iterable, Sequence
@@ -28,6 +27,7 @@ from typing import Any, Iterable, Sequence
 import numpy as np
 import pandas as pd
 
+from ..outputs import atomic_write_with
 from ..errors import SceneError
 from .point import COUNT_COLUMNS, STATUS_COLUMNS, TEXT_COLUMNS
 
@@ -202,15 +202,9 @@ class SweepFile:
         self._last_write = time.monotonic()
 
     def _atomic(self, write, target: Path | None = None) -> None:
-        target = self.path if target is None else target
-        handle, temporary = tempfile.mkstemp(prefix=f".{target.name}.", dir=target.parent or ".")
-        os.close(handle)
-        try:
-            write(temporary)
-            os.replace(temporary, target)
-        except BaseException:
-            Path(temporary).unlink(missing_ok=True)
-            raise
+        """Write ``target`` (default: the table's file) through ``write(temporary_path)`` atomically, with the
+        mode the umask gives (:func:`mbs_models.outputs.atomic_write_with`)."""
+        atomic_write_with(self.path if target is None else target, write)
 
 
 __all__ = ["SweepFile", "frame", "check_out", "FORMATS"]

@@ -66,6 +66,27 @@ def test_write_all_replaces_the_file(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["t.csv"]  # no temporary file left
 
 
+@pytest.mark.parametrize("suffix", [".csv", ".parquet"])
+@pytest.mark.parametrize("mask, mode", [(0o022, 0o644), (0o077, 0o600)])
+def test_files_honour_the_umask(tmp_path, suffix, mask, mode):
+    """The table (appended, rewritten) and its settings file get ``0666 & ~umask``, as any tool's outputs."""
+    import os
+    import stat
+
+    saved = os.umask(mask)
+    try:
+        file = SweepFile(tmp_path / f"t{suffix}", PARAMS, METRICS, parquet_interval=0.0)
+        file.write_settings({"end_time": 10.0})
+        file.append(ROWS[:1])
+        file.write_all(frame(ROWS, PARAMS, METRICS))
+        file.flush()
+    finally:
+        os.umask(saved)
+    assert len(list(tmp_path.iterdir())) == 2  # the table and its settings, no temporary file
+    for path in tmp_path.iterdir():
+        assert stat.S_IMODE(path.stat().st_mode) == mode, path.name
+
+
 @pytest.mark.parametrize("name, needle", [("t.txt", ".csv or .parquet"), ("missing/t.csv", "does not exist"),
                                           (".", "directory")])
 def test_bad_paths(tmp_path, name, needle):
