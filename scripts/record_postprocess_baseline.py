@@ -21,6 +21,7 @@ the threshold: the other branch of the impact search).
 
 from __future__ import annotations
 
+import hashlib
 import json
 import platform
 import subprocess
@@ -36,7 +37,6 @@ sys.path.insert(0, str(ROOT))
 from mbs_models import load_scene, model_i, model_ii, simplified_model, simulate  # noqa: E402
 from mbs_models.scenes import list_scenes, scene_path  # noqa: E402
 from validation.studies.hard_cases import HARD_CASES  # noqa: E402
-from record_v1_baseline import digest  # noqa: E402  (the same digest of an array as the version-1 baseline)
 
 
 def paper_cases():
@@ -61,6 +61,15 @@ def cases():
         for threshold in (1000.0, 50000.0):
             out.append((f"scene/{name}/standard/{threshold:g}", scene, 10.0, "standard", threshold))
     return out
+
+
+def digest(array) -> str | None:
+    """``"size:sha256"`` of an array's float64 bytes (as scripts/record_v1_baseline.py; this file is also loaded by
+    tests/results/test_postprocess_recorded.py, where the scripts directory is not importable)."""
+    if array is None:
+        return None
+    array = np.ascontiguousarray(np.asarray(array, dtype=float))
+    return f"{array.size}:" + hashlib.sha256(array.tobytes()).hexdigest()
 
 
 def hexed(value):
