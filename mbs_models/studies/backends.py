@@ -61,6 +61,15 @@ def exit_with_parent(parent: int, period: float = 1.0) -> None:
     threading.Thread(target=watch, name="exit-with-parent", daemon=True).start()
 
 
+def local_pool(workers: int) -> ProcessPoolExecutor:
+    """A pool of ``workers`` local processes: forked where possible (they start in milliseconds with this
+    process's imports), else spawned; each worker ends with its parent (:func:`exit_with_parent`)."""
+    methods = multiprocessing.get_all_start_methods()
+    context = multiprocessing.get_context("fork" if "fork" in methods else "spawn")
+    return ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=exit_with_parent,
+                               initargs=(os.getpid(),))
+
+
 class SerialBackend:
     """Runs every task in this process, in order."""
 
@@ -93,10 +102,7 @@ class ProcessBackend(SerialBackend):
         tasks = list(tasks)
         if not tasks:
             return
-        methods = multiprocessing.get_all_start_methods()
-        context = multiprocessing.get_context("fork" if "fork" in methods else "spawn")
-        pool = ProcessPoolExecutor(max_workers=min(self.workers, len(tasks)), mp_context=context,
-                                   initializer=exit_with_parent, initargs=(os.getpid(),))
+        pool = local_pool(min(self.workers, len(tasks)))
         try:
             futures = [pool.submit(function, task) for task in tasks]
             for future in as_completed(futures):
@@ -175,4 +181,4 @@ def make_backend(workers: int | None = None, scheduler: Any = None):
 
 
 __all__ = ["BACKENDS", "SerialBackend", "ProcessBackend", "DaskBackend", "make_backend", "batch_size",
-           "default_workers", "check_workers", "import_distributed", "exit_with_parent"]
+           "default_workers", "check_workers", "import_distributed", "exit_with_parent", "local_pool"]

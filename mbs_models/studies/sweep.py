@@ -19,9 +19,7 @@ scalars, never models or arrays.
 from __future__ import annotations
 
 import math
-import multiprocessing
-import os
-from concurrent.futures import Executor, Future, ProcessPoolExecutor
+from concurrent.futures import Executor, Future
 from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Callable, Iterable, Iterator, Sequence, TypeVar
@@ -29,7 +27,7 @@ from typing import Callable, Iterable, Iterator, Sequence, TypeVar
 from ..engine.accuracy import SolverSettings
 from ..errors import SceneError, SimulationError
 from ..scene import Scene
-from .backends import check_workers, default_workers, exit_with_parent  # noqa: F401  (default_workers: public)
+from .backends import check_workers, default_workers, exit_with_parent, local_pool  # noqa: F401  (default_workers, exit_with_parent: public)
 
 Progress = Callable[[int, int], None]
 T = TypeVar("T")
@@ -142,9 +140,7 @@ def process_pool(workers: int | None = None) -> Iterator[Executor]:
     if workers == 1:
         yield InlineExecutor()
         return
-    context = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn")
-    with ProcessPoolExecutor(max_workers=workers, mp_context=context,
-                             initializer=exit_with_parent, initargs=(os.getpid(),)) as pool:
+    with local_pool(workers) as pool:
         try:
             yield pool
         except BaseException:
@@ -170,9 +166,7 @@ def parallel_map(function: Callable[[T], R], items: Sequence[T], *, workers: int
         return out
     # small chunks: the last one is run by one worker while the others idle (32 per worker: < 1/32 of the work)
     chunk = max(1, math.ceil(len(items) / (workers * 32)))
-    context = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn")
-    with ProcessPoolExecutor(max_workers=min(workers, len(items)), mp_context=context,
-                             initializer=exit_with_parent, initargs=(os.getpid(),)) as pool:
+    with local_pool(min(workers, len(items))) as pool:
         for i, value in enumerate(pool.map(function, items, chunksize=chunk)):
             out.append(value)
             if progress and ((i + 1) % max(1, len(items) // 20) == 0 or i + 1 == len(items)):
