@@ -7,9 +7,6 @@ structures and numbers have run, and is compared with ``simulate(scene, ...)`` (
 
 from __future__ import annotations
 
-import dataclasses
-
-import numpy as np
 import pytest
 
 from mbs_models import Simulator, load_scene, model_i, model_ii, simplified_model, simulate
@@ -17,48 +14,13 @@ from mbs_models.engine.assembly import assemble, refill, structure_key
 from mbs_models.engine.mechanism import Mechanism
 from mbs_models.scenes import list_scenes, scene_path
 
-NOT_COMPARED = {"wall_time", "timings"}  # attributes and metrics() keys
 EARLY = ("max_barrel_displacement",)
-
-
-def assert_identical(a, b, where: str = "result") -> None:
-    """``a == b`` exactly, through dataclasses, dicts, lists and numpy arrays."""
-    if dataclasses.is_dataclass(a) and not isinstance(a, type):
-        assert type(a) is type(b), where
-        for f in dataclasses.fields(a):
-            if f.name not in NOT_COMPARED:
-                assert_identical(getattr(a, f.name), getattr(b, f.name), f"{where}.{f.name}")
-    elif isinstance(a, dict):
-        assert isinstance(b, dict) and list(a) == list(b), where
-        for key in a:
-            if key not in NOT_COMPARED:
-                assert_identical(a[key], b[key], f"{where}[{key!r}]")
-    elif isinstance(a, (list, tuple)):
-        assert type(a) is type(b) and len(a) == len(b), where
-        for i, (x, y) in enumerate(zip(a, b)):
-            assert_identical(x, y, f"{where}[{i}]")
-    elif isinstance(a, np.ndarray):
-        assert isinstance(b, np.ndarray) and a.dtype == b.dtype and a.shape == b.shape, where
-        assert np.array_equal(a, b), f"{where}: {np.max(np.abs(a - b))} off"
-    else:
-        assert type(a) is type(b) and a == b, f"{where}: {a!r} != {b!r}"
-
-
-def assert_results_identical(a, b) -> None:
-    assert_identical(a, b)
-    for name in ("barrel_position", "absorber_position", "contact_force", "kinetic_energy_history",
-                 "stored_energy_history"):
-        assert_identical(getattr(a, name), getattr(b, name), name)
-    assert_identical(a.energy_error(), b.energy_error(), "energy_error()")
-    assert_identical(a.metrics(), b.metrics(), "metrics()")
-    assert_identical(a.energy(), b.energy(), "energy()")
-
 
 PAPER_POINTS = [(factory, mass, gap) for gap in (0.0, 0.037, 0.12) for mass in (100.0, 1000.0, 500.0)
                 for factory in (model_i, model_ii)]
 
 
-def test_paper_models_over_masses_and_gaps_are_bit_identical():
+def test_paper_models_over_masses_and_gaps_are_bit_identical(assert_results_identical):
     """The three models, several masses and gaps, interleaved: each point reuses a system of the others."""
     fresh = {}
     with Simulator() as simulator:
@@ -77,7 +39,7 @@ def test_paper_models_over_masses_and_gaps_are_bit_identical():
         assert simulator.reuses == len(PAPER_POINTS) + 2 - 2
 
 
-def test_python_user_functions_are_bit_identical_too():
+def test_python_user_functions_are_bit_identical_too(assert_results_identical):
     with Simulator() as simulator:
         for gap in (0.0, 0.05):
             scene = model_ii(500.0, gap)
@@ -107,7 +69,7 @@ def _variant(name: str, scene):
 
 
 @pytest.mark.slow
-def test_shipped_scenes_are_bit_identical_after_other_points():
+def test_shipped_scenes_are_bit_identical_after_other_points(assert_results_identical):
     """Every shipped scene and a variant of its numbers, the variants first, through one Simulator."""
     scenes = {name: load_scene(scene_path(name)) for name in list_scenes()}
     order = [(name, _variant(name, scene)) for name, scene in scenes.items()] + list(scenes.items())
@@ -119,7 +81,7 @@ def test_shipped_scenes_are_bit_identical_after_other_points():
         assert simulator.reuses >= len(scenes)  # every scene at least reused its variant's system
 
 
-def test_refill_refuses_another_structure_and_the_cache_falls_back_to_a_fresh_build():
+def test_refill_refuses_another_structure_and_the_cache_falls_back_to_a_fresh_build(assert_results_identical):
     mechanism = Mechanism(model_ii(500.0, 0.0))
     assembly = assemble(mechanism.scene, "symbolic", mechanism)
     try:
@@ -136,7 +98,7 @@ def test_refill_refuses_another_structure_and_the_cache_falls_back_to_a_fresh_bu
         assert (simulator.assemblies, simulator.reuses) == (3, 0)  # one kept: model (ii) was dropped
 
 
-def test_a_failed_solve_discards_its_system(monkeypatch):
+def test_a_failed_solve_discards_its_system(monkeypatch, assert_results_identical):
     from mbs_models import SimulationError
     from mbs_models.engine import simulation
 

@@ -184,3 +184,37 @@ def test_the_docstring_example_of_simulate_holds():
     runner = doctest.DocTestRunner(optionflags=doctest.ELLIPSIS)
     runner.run(test)
     assert runner.summarize(verbose=False).failed == 0 and len(test.examples) >= 3
+
+
+def _every_shipped_scene():
+    from mbs_models import load_scene
+    from mbs_models.scenes import list_scenes, scene_path
+
+    return [pytest.param(load_scene(scene_path(name)), id=name) for name in list_scenes()]
+
+
+@pytest.mark.parametrize("solver", ["DOPRI5", "ODE23"])
+@pytest.mark.parametrize("scene", _every_shipped_scene())
+def test_first_same_as_last_solvers_skip_the_end_of_step_evaluation_bit_identically(
+        scene, solver, monkeypatch, assert_results_identical):
+    """DOPRI5's and ODE23's last stage is the end-of-step state, so the engine does not let Exudyn evaluate the
+    forces again after each step; every shipped scene (shots, breech pulses: loads in time, segmented runs) gives
+    the Result of the run that does, exactly."""
+    import mbs_models.engine.simulation as engine
+
+    settings = SolverSettings(solver=solver, relative_tolerance=1e-6, absolute_tolerance=1e-8, max_step=5e-3)
+    assert solver in engine.FIRST_SAME_AS_LAST_SOLVERS
+    skipping = simulate(scene, 1.5, settings)
+    monkeypatch.setattr(engine, "FIRST_SAME_AS_LAST_SOLVERS", ())
+    assert_results_identical(skipping, simulate(scene, 1.5, settings))
+
+
+def test_other_solvers_keep_exudyns_end_of_step_accelerations():
+    """RK44's last stage is not the end-of-step state: Exudyn evaluates the accelerations after each step."""
+    from mbs_models.engine.accuracy import solver_settings_for
+    from mbs_models.engine.simulation import exudyn_simulation_settings
+
+    fixed = exudyn_simulation_settings(SolverSettings(solver="RK44", step=1e-4), 1.0)
+    assert fixed.timeIntegration.explicit.computeEndOfStepAccelerations
+    standard = exudyn_simulation_settings(solver_settings_for("standard"), 1.0)
+    assert not standard.timeIntegration.explicit.computeEndOfStepAccelerations
