@@ -77,7 +77,6 @@ import math
 from typing import Iterable
 
 import numpy as np
-from scipy.optimize import brentq
 
 from ..elements.connector import GROUND
 from ..errors import SceneError
@@ -251,6 +250,8 @@ class PotentialWell:
         if found is None:
             return None
         a, b = sorted(found)
+        from scipy.optimize import brentq  # here: scipy.optimize costs ~0.4 s to import, and few scenes get here
+
         x = brentq(self.slope, a, b, xtol=1e-300, rtol=4.0 * np.finfo(float).eps, maxiter=500)
         return x, self.potential(x)
 
