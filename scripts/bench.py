@@ -15,7 +15,9 @@ What it measures (not a timed test: the numbers depend on the machine; the ratio
    the same adaptive scheme (Dormand-Prince 5(4), Hairer's step control) at the preset's rtol, atol and
    max step, compiled at run time with the system ``cc`` into a temporary directory and called through
    ctypes: the physical limit of what an integrator of these equations costs.  Skipped (and said so)
-   without a C compiler.
+   without a C compiler.  Beside it, Exudyn's floor: the same Exudyn system with built-in linear laws only, no
+   sensors and no pre-step function, per step, at the standard run's step count (what no change of this
+   product can go below).
 3. **Single-run cost breakdown**: import (in a fresh interpreter), assembly, solve, post-processing (and
    its parts), as fractions of one complete run.
 4. **Memory**: RSS over N consecutive runs in this process (Exudyn keeps models alive unless reset;
@@ -227,6 +229,35 @@ def element_costs(scene, end_time: float, repeats: int) -> tuple[dict, dict]:
     return {n: med(times[n]) for n in scenes}, {k: med(times[k]) for k in laws}
 
 
+def exudyn_floor_round(scene, end_time: float) -> tuple[float, int]:
+    """Exudyn's own cost per step for this scene's system, nothing of the product's: the same assembled items with
+    Exudyn's built-in linear law in place of every user function (the stiffness/damping the items already have),
+    no sensor stored, no pre-step function, the ``standard`` settings.  Returns (solve wall time s, steps): the
+    motion differs from the scene's, so compare per step."""
+    import exudyn
+
+    from mbs_models.engine.accuracy import solver_settings_for
+    from mbs_models.engine.assembly import assemble
+    from mbs_models.engine.simulation import exudyn_simulation_settings
+
+    settings = solver_settings_for("standard")
+    assembly = assemble(scene, settings.user_functions)
+    try:
+        mbs = assembly.mbs
+        for name in assembly.user_function_connectors:
+            mbs.SetObjectParameter(assembly.connectors[name], "springForceUserFunction", 0)
+        for index in assembly.sensors.values():
+            mbs.SetSensorParameter(index, "storeInternal", False)
+        ss = exudyn_simulation_settings(settings, end_time)
+        exudyn.config.printToConsole = False
+        start = time.perf_counter()
+        mbs.SolveDynamic(ss, solverType=getattr(exudyn.DynamicSolverType, settings.solver))
+        elapsed = time.perf_counter() - start
+        return elapsed, int(mbs.sys["dynamicSolver"].it.currentStepIndex)
+    finally:
+        assembly.close()
+
+
 # ------------------------------------------------------------------------------------------------ memory
 
 def memory_test(scene, runs: int, end_time: float, progress) -> list[tuple[int, int]]:
@@ -360,6 +391,8 @@ def main(argv=None) -> int:
                 clock("compiled", compiled_run)
             clock("compiled post", analyse, mechanism, samples, 1000.0)
         breakdown_round(scene, end_time, stages)
+        floor_seconds, floor_steps = exudyn_floor_round(scene, end_time)
+        add("exudyn floor per step", floor_seconds / floor_steps)
     directory.cleanup()
     t = {name: statistics.median(values) for name, values in timings.items()}
     stages = {name: statistics.median(values) for name, values in stages.items()}
@@ -458,6 +491,10 @@ def main(argv=None) -> int:
               f"(CPU time {t['standard cpu'] / t['compiled cpu']:.1f}x)")
         print(f"   standard complete run / (compiled + the same Python post-processing): "
               f"{t_standard / (t_c + t_c_post):6.2f}x")
+        floor = t["exudyn floor per step"] * result.steps
+        print(f"   Exudyn's floor / compiled integration:             {floor / t_c:6.1f}x [{ms(floor)}: this system "
+              f"with built-in linear laws only, no sensors, no pre-step, {1e6 * t['exudyn floor per step']:.2f} us "
+              f"per step, at the standard run's {result.steps} steps]")
     print("\n3. single-run cost breakdown (fractions of one complete standard run; import once per process)")
     run_total = sum(v for k, v in stages.items() if not k.startswith("  "))
     import_total = sum(imports.values())
