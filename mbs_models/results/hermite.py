@@ -65,26 +65,28 @@ class HermiteStack:
         return _combine(self.time.take(i), self.time.take(j), t, self.y.take(i, axis=1), self.y.take(j, axis=1),
                         self.dy.take(i, axis=1), self.dy.take(j, axis=1))
 
-    def on_intervals(self, fractions: np.ndarray) -> np.ndarray:
-        """Values at ``t_i + f h_i`` for every interval i and fraction f: shape (Q, intervals, fractions).
+    def at_fractions(self, fractions: np.ndarray) -> np.ndarray:
+        """Values at ``t_i + f h_i`` for every fraction f and interval i: shape (Q, fractions, intervals).
 
         On a zero-length interval (a jump at a segment boundary, e.g. a shot) the value before the jump.
         The basis is computed once with the intervals as the last axis (long inner loops), each quantity
-        on it in turn (small temporaries: one (Q, intervals, fractions) array of temporaries costs more
-        in fresh memory pages than in arithmetic), then laid out as (intervals, fractions).
+        on it in turn (small temporaries: one (Q, fractions, intervals) array of temporaries costs more
+        in fresh memory pages than in arithmetic).
         """
         t0, t1 = self.time[:-1], self.time[1:]
         f = np.asarray(fractions, dtype=float)[:, None]
         jump = not np.all(t1 > t0)
         with np.errstate(invalid="ignore", divide="ignore") if jump else nullcontext():
             basis = _basis(t0, t1, t0 + f * (t1 - t0))
-        out = np.empty((len(self.y), len(t0), f.shape[0]))
+        out = np.empty((len(self.y), f.shape[0], len(t0)))
         for q in range(len(self.y)):
             values = _apply(basis, self.y[q, :-1], self.y[q, 1:], self.dy[q, :-1], self.dy[q, 1:])
-            if jump:
-                values = np.where(t1 > t0, values, self.y[q, :-1])
-            out[q] = values.T
+            out[q] = np.where(t1 > t0, values, self.y[q, :-1]) if jump else values
         return out
+
+    def on_intervals(self, fractions: np.ndarray) -> np.ndarray:
+        """:meth:`at_fractions` laid out as (Q, intervals, fractions) (a transposed view)."""
+        return self.at_fractions(fractions).transpose(0, 2, 1)
 
 
 class HermiteTrajectory:

@@ -29,7 +29,7 @@ class Samples:
 class Interpolant:
     """Hermite interpolation of every body's state between samples.
 
-    ``x[name]``, ``v[name]``: one body's position and velocity; :meth:`state` and :meth:`on_intervals`
+    ``x[name]``, ``v[name]``: one body's position and velocity; :meth:`state` and :meth:`at_fractions`
     give every body's at once (one interval search and one set of basis polynomials for all; the same
     values as the single trajectories, bit for bit).
     """
@@ -53,9 +53,9 @@ class Interpolant:
         """Every body's position (m) and velocity (m/s) at times ``t`` (s, any shape)."""
         return self._split(self._stack(t))
 
-    def on_intervals(self, fractions) -> tuple[dict, dict]:
-        """Every body's position and velocity at ``t_i + f h_i``, shape (intervals, fractions) each."""
-        return self._split(self._stack.on_intervals(fractions))
+    def at_fractions(self, fractions) -> tuple[dict, dict]:
+        """Every body's position and velocity at ``t_i + f h_i``, shape (fractions, intervals) each."""
+        return self._split(self._stack.at_fractions(fractions))
 
     def positions(self, t) -> dict:
         return self.state(t)[0]
