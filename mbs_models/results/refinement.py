@@ -65,7 +65,11 @@ def _crossing_search(time: np.ndarray, first: np.ndarray, last: np.ndarray, open
 
 
 class _Rounds:
-    """Searches with the function each evaluates on the interpolated state ``(x, v, t)``, run in lockstep."""
+    """Searches with the function each evaluates on the interpolated state ``(x, v, t)``, run in lockstep.
+
+    The functions are elementwise in the times, so neighbouring parts of a round that evaluate the same
+    function (one contact's peak and crossing searches) are evaluated in one call on their joined times.
+    """
 
     def __init__(self, interp):
         self.interp = interp
@@ -85,12 +89,25 @@ class _Rounds:
         def evaluate(times, parts):
             x, v = self.interp.state(times)
             out = []
-            for index, part in parts:
-                out.append(self.functions[index]({n: a[part] for n, a in x.items()},
-                                                 {n: a[part] for n, a in v.items()}, times[part]))
+            for function, span, members in _same_function_spans(self.functions, parts):
+                values = function({n: a[span] for n, a in x.items()}, {n: a[span] for n, a in v.items()}, times[span])
+                out += [values[part.start - span.start:part.stop - span.start] for part in members]
             return out
 
         return run(evaluate, self.searches)
+
+
+def _same_function_spans(functions: list, parts: list[tuple[int, slice]]) -> list[tuple]:
+    """``(function, span, parts)`` of each maximal run of neighbouring ``parts`` (``(search index, slice)``)
+    whose searches evaluate the same function: ``span`` is the slice they cover together."""
+    runs: list[tuple] = []
+    for index, part in parts:
+        function = functions[index]
+        if runs and runs[-1][0] is function and runs[-1][1][-1].stop == part.start:
+            runs[-1][1].append(part)
+        else:
+            runs.append((function, [part]))
+    return [(function, slice(members[0].start, members[-1].stop), members) for function, members in runs]
 
 
 def contact_force_function(mechanism, connector):
