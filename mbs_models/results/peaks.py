@@ -66,14 +66,16 @@ def refine_maximum(time: np.ndarray, y: np.ndarray, dy: np.ndarray) -> tuple[flo
     time, y, dy = (np.asarray(a, dtype=float) for a in (time, y, dy))
     k = int(np.argmax(y))
     best_value, best_time = float(y[k]), float(time[k])
-    h = np.diff(time)
-    near_sample_max = [i for i in (k - 1, k) if 0 <= i < len(h)]
-    i = np.union1d(np.flatnonzero((dy[:-1] > 0) & (dy[1:] <= 0)), near_sample_max).astype(int)
-    i = i[h[i] > 0]
+    candidate = (dy[:-1] > 0) & (dy[1:] <= 0)  # per interval: the derivative turns from positive
+    candidate[max(k - 1, 0):k + 1] = True  # the intervals beside the sample maximum
+    i = np.flatnonzero(candidate)
+    h = time[i + 1] - time[i]
+    nonempty = h > 0
+    i, h = i[nonempty], h[nonempty]
     if not len(i):
         return best_value, best_time
     # y(s) = a s^3 + b s^2 + c s + d on s in [0, 1]
-    y0, y1, d0, d1 = y[i], y[i + 1], dy[i] * h[i], dy[i + 1] * h[i]
+    y0, y1, d0, d1 = y[i], y[i + 1], dy[i] * h, dy[i + 1] * h
     a = 2 * y0 + d0 - 2 * y1 + d1
     b = -3 * y0 - 2 * d0 + 3 * y1 - d1
     c = d0
@@ -87,7 +89,7 @@ def refine_maximum(time: np.ndarray, y: np.ndarray, dy: np.ndarray) -> tuple[flo
             value = np.where(np.isfinite(s) & (s >= 0.0) & (s <= 1.0) & np.isfinite(value), value, -np.inf)
             j = int(np.argmax(value))
             if value[j] > best_value:
-                best_value, best_time = float(value[j]), float(time[i[j]] + s[j] * h[i[j]])
+                best_value, best_time = float(value[j]), float(time[i[j]] + s[j] * h[j])
     return best_value, best_time
 
 
