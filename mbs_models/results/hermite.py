@@ -49,21 +49,47 @@ def _combine(t0, t1, t, y0, y1, dy0, dy1):
 class HermiteStack:
     """Piecewise-cubic Hermite interpolants of Q quantities sampled at the same times.
 
-    ``y`` and ``dy`` have shape (Q, samples); calls return shape (Q,) + the shape of the times.
+    ``y`` and ``dy`` have shape (Q, samples); calls return shape (Q,) + the shape of the times.  The
+    sample times and the values are kept as the rows of one table, so that a call gathers the samples
+    on both sides of every time in two gathers (:meth:`chain` shares the rows that are values of one
+    quantity and derivatives of another).
     """
 
     def __init__(self, time: np.ndarray, y: np.ndarray, dy: np.ndarray):
-        self.time = np.asarray(time, dtype=float)
-        self.y = np.asarray(y, dtype=float).reshape(-1, len(self.time))
-        self.dy = np.asarray(dy, dtype=float).reshape(-1, len(self.time))
+        time = np.asarray(time, dtype=float)
+        y = np.asarray(y, dtype=float).reshape(-1, len(time))
+        dy = np.asarray(dy, dtype=float).reshape(-1, len(time))
+        self._set_table(np.concatenate([time[None, :], y, dy]), len(y), 1 + len(y))
+
+    @classmethod
+    def chain(cls, time: np.ndarray, levels: list[np.ndarray]) -> "HermiteStack":
+        """The interpolants of a chain of quantities each the derivative of the one before, sampled as
+        ``levels`` (each of shape (Q, samples); e.g. positions, velocities, accelerations): the values are
+        every level but the last, their derivatives every level but the first (so velocities are
+        interpolated from accelerations, positions from velocities), ``Q (len(levels) - 1)`` quantities."""
+        time = np.asarray(time, dtype=float)
+        rows = [np.asarray(level, dtype=float).reshape(-1, len(time)) for level in levels]
+        stack = cls.__new__(cls)
+        stack._set_table(np.concatenate([time[None, :]] + rows), sum(len(r) for r in rows[:-1]), 1 + len(rows[0]))
+        return stack
+
+    def _set_table(self, table: np.ndarray, count: int, first_derivative: int) -> None:
+        """``table``: the times (row 0), the ``count`` values from row 1, their derivatives from row
+        ``first_derivative``."""
+        self._table = table
+        self._values = slice(1, 1 + count)
+        self._derivatives = slice(first_derivative, first_derivative + count)
+        self.time, self.y, self.dy = table[0], table[self._values], table[self._derivatives]
 
     def __call__(self, t) -> np.ndarray:
         """Values at times ``t`` (s, any shape), the interval of each found by bisection."""
         t = np.asarray(t, dtype=float)
         i = np.minimum(np.maximum(np.searchsorted(self.time, t, side="right") - 1, 0), len(self.time) - 2)
-        j = i + 1  # take: the same gathers as indexing, several times faster along axis 1
-        return _combine(self.time.take(i), self.time.take(j), t, self.y.take(i, axis=1), self.y.take(j, axis=1),
-                        self.dy.take(i, axis=1), self.dy.take(j, axis=1))
+        # take: the same gathers as indexing, several times faster along axis 1
+        before, after = self._table.take(i, axis=1), self._table.take(i + 1, axis=1)
+        values, derivatives = self._values, self._derivatives
+        return _combine(before[0], after[0], t, before[values], after[values], before[derivatives],
+                        after[derivatives])
 
     def at_fractions(self, fractions: np.ndarray) -> np.ndarray:
         """Values at ``t_i + f h_i`` for every fraction f and interval i: shape (Q, fractions, intervals).

@@ -8,6 +8,7 @@ basis polynomials.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -37,12 +38,22 @@ class Interpolant:
     def __init__(self, s: Samples):
         self.time = s.time
         self.names = list(s.positions)
-        self.x = {name: HermiteTrajectory(s.time, s.positions[name], s.velocities[name]) for name in s.positions}
-        self.v = {name: HermiteTrajectory(s.time, s.velocities[name], s.accelerations[name]) for name in s.positions}
-        self._stack = HermiteStack(s.time, np.array([s.positions[n] for n in self.names]
-                                                     + [s.velocities[n] for n in self.names]).reshape(-1, len(s.time)),
-                                   np.array([s.velocities[n] for n in self.names]
-                                            + [s.accelerations[n] for n in self.names]).reshape(-1, len(s.time)))
+        self._samples = s
+        self._stack = HermiteStack.chain(s.time, [[s.positions[n] for n in self.names],
+                                                  [s.velocities[n] for n in self.names],
+                                                  [s.accelerations[n] for n in self.names]])
+
+    @cached_property
+    def x(self) -> dict[str, HermiteTrajectory]:
+        """Each body's position (m) interpolated from its velocity."""
+        s = self._samples
+        return {name: HermiteTrajectory(s.time, s.positions[name], s.velocities[name]) for name in self.names}
+
+    @cached_property
+    def v(self) -> dict[str, HermiteTrajectory]:
+        """Each body's velocity (m/s) interpolated from its acceleration."""
+        s = self._samples
+        return {name: HermiteTrajectory(s.time, s.velocities[name], s.accelerations[name]) for name in self.names}
 
     def _split(self, values) -> tuple[dict, dict]:
         n = len(self.names)
