@@ -75,7 +75,9 @@ def maxima_search(lo: np.ndarray, hi: np.ndarray, points: int = 65, levels: int 
         shift = 0.5 * (y0[vertex] - y2[vertex]) / curvature[vertex]
         step = grid[r, 1] - grid[r, 0]
         t_vertex = grid[r, j[r]] + shift * step
-        value = np.asarray((yield t_vertex), dtype=float)
+        times = best_time.copy()  # one time per bracket: its vertex, or its best point again (value unused)
+        times[r] = t_vertex
+        value = np.asarray((yield times), dtype=float)[r]
         better = value > best_value[r]
         best_value[r[better]] = value[better]
         best_time[r[better]] = t_vertex[better]
@@ -107,10 +109,11 @@ def values_at(times: np.ndarray):
 def run(evaluate: Callable[[np.ndarray, list[tuple[int, slice]]], list[np.ndarray]], searches: list) -> list:
     """Drive several searches in lockstep; return their results in order.
 
-    At each round every unfinished search asks for values at an array of times; ``evaluate`` gets all
-    those times concatenated (1-D, s) and ``(search index, slice)`` of each search's part, and returns
-    one array of values per part (each search may evaluate a different function on the same
-    interpolated state).  So a round costs one evaluation whatever the number of searches and brackets.
+    At each round every unfinished search asks for values at an array of times, one row (or one time)
+    per bracket, in the order of its brackets; ``evaluate`` gets all those times concatenated (1-D, s)
+    and ``(search index, slice)`` of each search's part, and returns one array of values per part (each
+    search, or each bracket, may evaluate a different function on the same interpolated state).  So a
+    round costs one evaluation whatever the number of searches and brackets.
     """
     results: list = [None] * len(searches)
     requests = {}

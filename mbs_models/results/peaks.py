@@ -96,22 +96,25 @@ def refine_maximum(time: np.ndarray, y: np.ndarray, dy: np.ndarray) -> tuple[flo
 def maxima_near_samples(time: np.ndarray, ks: np.ndarray, points: int = 65, levels: int = 4):
     """The searches for the maxima of a function near each sample ``ks[i]``, and how to read them.
 
-    Returns ``(searches, assemble)``: generators for :func:`~mbs_models.results.nested_grids.run` (a
-    :func:`~mbs_models.results.nested_grids.maxima_search` over [t_{k-1}, t_{k+1}] for every k whose
-    bracket is not empty; the value at ``t_k`` itself where it is, equal times at a jump), and
-    ``assemble(results)`` -> ``(values, times)`` arrays in the order of ``ks``.
+    Returns ``(searches, brackets, assemble)``: generators for :func:`~mbs_models.results.nested_grids.run`
+    (a :func:`~mbs_models.results.nested_grids.maxima_search` over [t_{k-1}, t_{k+1}] for every k whose
+    bracket is not empty; the value at ``t_k`` itself where it is, equal times at a jump), the indices
+    into ``ks`` of each search's brackets (increasing), and ``assemble(results)`` -> ``(values, times)``
+    arrays in the order of ``ks``.
     """
     time = np.asarray(time, dtype=float)
     ks = np.asarray(ks, dtype=int)
     lo = time[np.maximum(ks - 1, 0)]
     hi = time[np.minimum(ks + 1, len(time) - 1)]
     open_ = hi > lo
-    searches, kinds = [], []
+    searches, brackets, kinds = [], [], []
     if open_.any():
         searches.append(maxima_search(lo[open_], hi[open_], points, levels))
+        brackets.append(np.flatnonzero(open_))
         kinds.append("open")
     if not open_.all():
         searches.append(values_at(time[ks[~open_]]))
+        brackets.append(np.flatnonzero(~open_))
         kinds.append("closed")
 
     def assemble(results) -> tuple[np.ndarray, np.ndarray]:
@@ -125,7 +128,7 @@ def maxima_near_samples(time: np.ndarray, ks: np.ndarray, points: int = 65, leve
                 values[~open_] = np.asarray(result, dtype=float)
         return values, times
 
-    return searches, assemble
+    return searches, brackets, assemble
 
 
 def refine_function_maxima(f: Callable[[np.ndarray], np.ndarray], time: np.ndarray, ks: np.ndarray,
@@ -138,7 +141,7 @@ def refine_function_maxima(f: Callable[[np.ndarray], np.ndarray], time: np.ndarr
     resolution ~ h / points**levels.  Where the bracket is empty (equal times at a jump) the value is
     ``f(t_k)`` at ``t_k``.
     """
-    searches, assemble = maxima_near_samples(time, ks, points, levels)
+    searches, _, assemble = maxima_near_samples(time, ks, points, levels)
     return assemble(run(lambda times, parts: [f(times[part]) for _, part in parts], searches))
 
 
