@@ -183,7 +183,7 @@ class Connector:
         """Cumulative dissipated energy (J) at the output samples: ``damping d'^2`` integrated.
 
         ``d_nodes``, ``rate_nodes`` and ``times_nodes`` are values at each output interval's quadrature
-        nodes (shape (intervals, nodes)); ``stored`` is :meth:`stored_energy` at the output samples.
+        nodes (shape (nodes, intervals)); ``stored`` is :meth:`stored_energy` at the output samples.
         """
         return quadrature(self.damping * rate_nodes ** 2)
 

@@ -295,14 +295,16 @@ def _read_segment(assembly: Assembly, settings: SolverSettings, start_time: floa
         if len(data) and data[0, 0] == start_time:
             data[0, 1] = value  # Exudyn records 0 at the start (see _initial_accelerations)
     for name, data in columns.items():
-        if not np.all(np.isfinite(data)):
+        if not np.isfinite(data).all():
             first = int(np.flatnonzero(~np.all(np.isfinite(data), axis=1))[0])
             raise SimulationError(f"Exudyn {settings.solver} produced a non-finite {name.replace('_', ' ')} at "
                                   f"t = {data[first, 0]:.6g} s (the solve diverged; try a smaller step or "
                                   "tighter tolerance)")
     time = columns["barrel_position"][:, 0]
-    keep = np.concatenate([[True], np.diff(time) > 0])  # drop duplicate time stamps, if any
-    return time[keep], {name: data[keep, 1] for name, data in columns.items()}
+    later = time[1:] > time[:-1]
+    rows = slice(None) if later.all() else np.concatenate([[True], later])  # drop duplicate time stamps, if any
+    return (np.ascontiguousarray(time[rows]),
+            {name: np.ascontiguousarray(data[rows, 1]) for name, data in columns.items()})
 
 
 def _collect(assembly: Assembly, end_time: float, settings: SolverSettings,
@@ -315,8 +317,11 @@ def _collect(assembly: Assembly, end_time: float, settings: SolverSettings,
     """
     if segments is None:
         segments = [_read_segment(assembly, settings, 0.0, initial_accelerations)]
-    time = np.concatenate([t for t, _ in segments])
-    values = {name: np.concatenate([v[name] for _, v in segments]) for name in assembly.sensors}
+    if len(segments) == 1:
+        time, values = segments[0]
+    else:
+        time = np.concatenate([t for t, _ in segments])
+        values = {name: np.concatenate([v[name] for _, v in segments]) for name in assembly.sensors}
     if len(time) < 2:
         raise SimulationError(f"Exudyn {settings.solver} produced fewer than two output samples")
     if abs(time[-1] - end_time) > 1e-6 * max(1.0, end_time):

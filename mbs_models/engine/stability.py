@@ -381,10 +381,25 @@ class SteppedOverContact:
     duration: float
 
 
-def _cubic_coefficients(h, y0, y1, d0, d1):
-    """Coefficients (a, b, c, d) of the Hermite cubic a s^3 + b s^2 + c s + d on s in [0, 1]."""
-    d0, d1 = d0 * h, d1 * h
+def _cubic_coefficients(y0, y1, d0, d1):
+    """Coefficients (a, b, c, d) of the Hermite cubic a s^3 + b s^2 + c s + d on s in [0, 1] with end values
+    y0, y1 and end slopes (per unit s) d0, d1."""
     return 2 * y0 + d0 - 2 * y1 + d1, -3 * y0 - 2 * d0 + 3 * y1 - d1, d0, y0
+
+
+def _may_exceed_noise(y0, y1, d0, d1) -> np.ndarray:
+    """False where the Hermite cubic with end values y0, y1 and end slopes d0, d1 (per unit s) surely stays at
+    or below :data:`PENETRATION_NOISE` on [0, 1], also as evaluated in floating point.
+
+    The cubic is ``H00 y0 + H01 y1 + H10 d0 + H11 d1`` with ``H00 + H01 = 1`` (both in [0, 1]) and
+    ``|H10|, |H11| <= 4/27``, so it never exceeds ``max(y0, y1) + 4/27 (|d0| + |d1|)``; its evaluation
+    through the coefficients of :func:`_cubic_coefficients` and Horner's rule adds less than 1e-14 of
+    ``M = |y0| + |y1| + |d0| + |d1|``.  The test ``max(y0, y1) + (|d0| + |d1|) / 4 + 1e-12 M > noise / 2``
+    keeps a margin far above both, so every interval it drops would have given a value <= the noise.
+    """
+    spread = np.abs(d0) + np.abs(d1)
+    size = np.abs(y0) + np.abs(y1) + spread
+    return np.maximum(y0, y1) + 0.25 * spread + 1e-12 * size > 0.5 * PENETRATION_NOISE
 
 
 def stepped_over_contacts(contact, time: np.ndarray, relative_position: np.ndarray,
@@ -396,7 +411,8 @@ def stepped_over_contacts(contact, time: np.ndarray, relative_position: np.ndarr
     ``relative_position`` is its d (m; x_M - x_m for an absorber), ``relative_velocity`` its rate
     (m/s), at the output times ``time`` (s); ``contact_force`` the force (N) the solver recorded there.
     Only touches whose free-motion peak force exceeds ``MISSED_CONTACT_FORCE_FRACTION * impact_threshold``
-    and whose penetration exceeds :data:`PENETRATION_NOISE` are reported.
+    and whose penetration exceeds :data:`PENETRATION_NOISE` are reported.  The intervals whose cubic
+    surely stays below the noise (:func:`_may_exceed_noise`: nearly all of them) are not searched.
     """
     if isinstance(contact, Scene):
         contacts = Mechanism(contact).absorber_contacts
@@ -406,20 +422,24 @@ def stepped_over_contacts(contact, time: np.ndarray, relative_position: np.ndarr
     if len(time) < 2:
         return []
     penetration = contact.penetration(np.asarray(relative_position, dtype=float))
-    quiet = (contact_force[:-1] <= 0) & (contact_force[1:] <= 0) & (penetration[:-1] <= 0) & (penetration[1:] <= 0)
-    candidates = np.flatnonzero(quiet)
-    if not len(candidates):
+    apart = (contact_force <= 0) & (penetration <= 0)
+    quiet = np.flatnonzero(apart[:-1] & apart[1:])  # force 0 and bodies apart at both ends
+    h = time[quiet + 1] - time[quiet]
+    y0, y1 = penetration[quiet], penetration[quiet + 1]
+    d0, d1 = relative_velocity[quiet] * h, relative_velocity[quiet + 1] * h
+    searched = np.flatnonzero(_may_exceed_noise(y0, y1, d0, d1))
+    if not len(searched):
         return []
-    h = np.diff(time)[candidates]
-    a, b, c, d = _cubic_coefficients(h, penetration[candidates], penetration[candidates + 1],
-                                     relative_velocity[candidates], relative_velocity[candidates + 1])
+    candidates, h = quiet[searched], h[searched]
+    a, b, c, d = _cubic_coefficients(y0[searched], y1[searched], d0[searched], d1[searched])
     # maximum of the cubic on (0, 1): roots of 3a s^2 + 2b s + c, in the cancellation-free form
     # q = -(B + sign(B) sqrt(B^2 - 4AC)) / 2, s = q / A and C / q (a may be ~0: a parabola)
     A, B, C = 3 * a, 2 * b, c
     best_s = np.full(len(candidates), np.nan)
     best_p = np.full(len(candidates), -np.inf)
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-        q = -0.5 * (B + np.copysign(np.sqrt(np.where(B * B - 4 * A * C >= 0, B * B - 4 * A * C, np.nan)), B))
+        disc = B * B - 4 * A * C
+        q = -0.5 * (B + np.copysign(np.sqrt(np.where(disc >= 0, disc, np.nan)), B))
         for s in (q / A, C / q):
             value = ((a * s + b) * s + c) * s + d
             better = (s > 0) & (s < 1) & np.isfinite(value) & (value > best_p)

@@ -3,6 +3,8 @@
 Dissipated energies and the work of time-varying loads are integrated with 3-point Gauss-Legendre
 quadrature in every sample interval, on the Hermite-interpolated state at the nodes
 (``t_i + f h_i``, f = 1/2 -+ sqrt(15)/10 and 1/2, weights 5/18, 8/18, 5/18), then summed cumulatively.
+Values at the nodes are arrays of shape (nodes, intervals): one row per node, the intervals innermost
+(long inner loops for every operation on them, the quadrature's sum over nodes included).
 """
 
 from __future__ import annotations
@@ -19,8 +21,9 @@ _GL_WEIGHTS = np.array([5.0, 8.0, 5.0]) / 18.0
 
 
 def cumulative_quadrature(t: np.ndarray, power_at_nodes: np.ndarray) -> np.ndarray:
-    """Cumulative integral (J) over the sample intervals from the power (W) at each interval's Gauss nodes."""
-    per_interval = (power_at_nodes * _GL_WEIGHTS[None, :]).sum(axis=1) * np.diff(t)
+    """Cumulative integral (J) over the sample intervals from the power (W) at each interval's Gauss nodes
+    (shape (nodes, intervals)): ``E_k = sum_{i<k} h_i sum_j w_j P(t_i + f_j h_i)``."""
+    per_interval = (power_at_nodes * _GL_WEIGHTS[:, None]).sum(axis=0) * np.diff(t)
     return np.concatenate([[0.0], np.cumsum(per_interval)])
 
 
@@ -59,8 +62,8 @@ def energies(mechanism, s: Samples, interp: Interpolant) -> Energies:
     ``c d'^2`` for a damper, ``F p' - dU/dt`` for a contact).
     """
     t = s.time
-    nodes_t = t[:-1, None] + _GL_NODES[None, :] * np.diff(t)[:, None]
-    x_nodes, v_nodes = interp.on_intervals(_GL_NODES)
+    nodes_t = t[:-1] + _GL_NODES[:, None] * np.diff(t)
+    x_nodes, v_nodes = interp.at_fractions(_GL_NODES)
     kinetic = {body.name: 0.5 * body.mass * s.velocities[body.name] ** 2 for body in mechanism.bodies}
     stored: dict[str, np.ndarray] = {}
     dissipated: dict[str, np.ndarray] = {}

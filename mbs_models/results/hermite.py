@@ -49,42 +49,70 @@ def _combine(t0, t1, t, y0, y1, dy0, dy1):
 class HermiteStack:
     """Piecewise-cubic Hermite interpolants of Q quantities sampled at the same times.
 
-    ``y`` and ``dy`` have shape (Q, samples); calls return shape (Q,) + the shape of the times.
+    ``y`` and ``dy`` have shape (Q, samples); calls return shape (Q,) + the shape of the times.  The
+    sample times and the values are kept as the rows of one table, so that a call gathers the samples
+    on both sides of every time in two gathers (:meth:`chain` shares the rows that are values of one
+    quantity and derivatives of another).
     """
 
     def __init__(self, time: np.ndarray, y: np.ndarray, dy: np.ndarray):
-        self.time = np.asarray(time, dtype=float)
-        self.y = np.asarray(y, dtype=float).reshape(-1, len(self.time))
-        self.dy = np.asarray(dy, dtype=float).reshape(-1, len(self.time))
+        time = np.asarray(time, dtype=float)
+        y = np.asarray(y, dtype=float).reshape(-1, len(time))
+        dy = np.asarray(dy, dtype=float).reshape(-1, len(time))
+        self._set_table(np.concatenate([time[None, :], y, dy]), len(y), 1 + len(y))
+
+    @classmethod
+    def chain(cls, time: np.ndarray, levels: list[np.ndarray]) -> "HermiteStack":
+        """The interpolants of a chain of quantities each the derivative of the one before, sampled as
+        ``levels`` (each of shape (Q, samples); e.g. positions, velocities, accelerations): the values are
+        every level but the last, their derivatives every level but the first (so velocities are
+        interpolated from accelerations, positions from velocities), ``Q (len(levels) - 1)`` quantities."""
+        time = np.asarray(time, dtype=float)
+        rows = [np.asarray(level, dtype=float).reshape(-1, len(time)) for level in levels]
+        stack = cls.__new__(cls)
+        stack._set_table(np.concatenate([time[None, :]] + rows), sum(len(r) for r in rows[:-1]), 1 + len(rows[0]))
+        return stack
+
+    def _set_table(self, table: np.ndarray, count: int, first_derivative: int) -> None:
+        """``table``: the times (row 0), the ``count`` values from row 1, their derivatives from row
+        ``first_derivative``."""
+        self._table = table
+        self._values = slice(1, 1 + count)
+        self._derivatives = slice(first_derivative, first_derivative + count)
+        self.time, self.y, self.dy = table[0], table[self._values], table[self._derivatives]
 
     def __call__(self, t) -> np.ndarray:
         """Values at times ``t`` (s, any shape), the interval of each found by bisection."""
         t = np.asarray(t, dtype=float)
         i = np.minimum(np.maximum(np.searchsorted(self.time, t, side="right") - 1, 0), len(self.time) - 2)
-        j = i + 1  # take: the same gathers as indexing, several times faster along axis 1
-        return _combine(self.time.take(i), self.time.take(j), t, self.y.take(i, axis=1), self.y.take(j, axis=1),
-                        self.dy.take(i, axis=1), self.dy.take(j, axis=1))
+        # take: the same gathers as indexing, several times faster along axis 1
+        before, after = self._table.take(i, axis=1), self._table.take(i + 1, axis=1)
+        values, derivatives = self._values, self._derivatives
+        return _combine(before[0], after[0], t, before[values], after[values], before[derivatives],
+                        after[derivatives])
 
-    def on_intervals(self, fractions: np.ndarray) -> np.ndarray:
-        """Values at ``t_i + f h_i`` for every interval i and fraction f: shape (Q, intervals, fractions).
+    def at_fractions(self, fractions: np.ndarray) -> np.ndarray:
+        """Values at ``t_i + f h_i`` for every fraction f and interval i: shape (Q, fractions, intervals).
 
         On a zero-length interval (a jump at a segment boundary, e.g. a shot) the value before the jump.
         The basis is computed once with the intervals as the last axis (long inner loops), each quantity
-        on it in turn (small temporaries: one (Q, intervals, fractions) array of temporaries costs more
-        in fresh memory pages than in arithmetic), then laid out as (intervals, fractions).
+        on it in turn (small temporaries: one (Q, fractions, intervals) array of temporaries costs more
+        in fresh memory pages than in arithmetic).
         """
         t0, t1 = self.time[:-1], self.time[1:]
         f = np.asarray(fractions, dtype=float)[:, None]
         jump = not np.all(t1 > t0)
         with np.errstate(invalid="ignore", divide="ignore") if jump else nullcontext():
             basis = _basis(t0, t1, t0 + f * (t1 - t0))
-        out = np.empty((len(self.y), len(t0), f.shape[0]))
+        out = np.empty((len(self.y), f.shape[0], len(t0)))
         for q in range(len(self.y)):
             values = _apply(basis, self.y[q, :-1], self.y[q, 1:], self.dy[q, :-1], self.dy[q, 1:])
-            if jump:
-                values = np.where(t1 > t0, values, self.y[q, :-1])
-            out[q] = values.T
+            out[q] = np.where(t1 > t0, values, self.y[q, :-1]) if jump else values
         return out
+
+    def on_intervals(self, fractions: np.ndarray) -> np.ndarray:
+        """:meth:`at_fractions` laid out as (Q, intervals, fractions) (a transposed view)."""
+        return self.at_fractions(fractions).transpose(0, 2, 1)
 
 
 class HermiteTrajectory:

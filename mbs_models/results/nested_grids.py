@@ -25,20 +25,29 @@ def uniform_grids(lo: np.ndarray, hi: np.ndarray, points: int) -> np.ndarray:
 
     The same operations as ``np.linspace`` on each pair: ``lo + i * ((hi - lo) / (points - 1))`` (or
     ``lo + (i / (points - 1)) * (hi - lo)`` where the step underflows to 0), the last point ``hi``.
+    ``lo`` and ``hi`` are 1-D float arrays.
     """
-    lo = np.asarray(lo, dtype=float)[:, None]
-    hi = np.asarray(hi, dtype=float)[:, None]
     div = points - 1
-    index = np.arange(0, points, dtype=float)[None, :]
+    index = _indices(points)
     delta = hi - lo
     step = delta / div
-    offsets = index * step
-    zero = (step == 0)[:, 0]
-    if zero.any():  # numpy's special case for denormal steps (gh-5437), per row
-        offsets[zero] = (index / div) * delta[zero]
-    grid = offsets + lo
-    grid[:, -1] = hi[:, 0]
+    grid = index * step[:, None]
+    if not step.all():  # numpy's special case for denormal steps (gh-5437), per row
+        zero = step == 0
+        grid[zero] = (index / div) * delta[zero, None]
+    grid += lo[:, None]
+    grid[:, -1] = hi
     return grid
+
+
+_INDICES: dict[int, np.ndarray] = {}
+
+
+def _indices(points: int) -> np.ndarray:
+    """``np.arange(points, dtype=float)`` (the grid indices 0, 1, ..., points - 1), made once per size."""
+    if points not in _INDICES:
+        _INDICES[points] = np.arange(0, points, dtype=float)
+    return _INDICES[points]
 
 
 def maxima_search(lo: np.ndarray, hi: np.ndarray, points: int = 65, levels: int = 4):
@@ -47,12 +56,15 @@ def maxima_search(lo: np.ndarray, hi: np.ndarray, points: int = 65, levels: int 
     lo = np.asarray(lo, dtype=float)
     hi = np.asarray(hi, dtype=float)
     rows = np.arange(len(lo))
+    first = rows * points  # each row's first point in the flattened grid
     for _ in range(levels):
         grid = uniform_grids(lo, hi, points)
         values = np.asarray((yield grid), dtype=float)
-        j = np.argmax(values, axis=1)
-        lo, hi = grid[rows, np.maximum(j - 1, 0)], grid[rows, np.minimum(j + 1, points - 1)]
-    best_value, best_time = values[rows, j], grid[rows, j]
+        j = values.argmax(axis=1)
+        flat = grid.ravel()
+        lo, hi = flat.take(first + np.maximum(j, 1) - 1), flat.take(first + np.minimum(j, points - 2) + 1)
+    at_best = first + j
+    best_value, best_time = values.ravel().take(at_best), grid.ravel().take(at_best)
     inner = rows[(j > 0) & (j < points - 1)]  # the best point has two neighbours
     ji = j[inner]
     y0, y1, y2 = values[inner, ji - 1], values[inner, ji], values[inner, ji + 1]
@@ -63,7 +75,9 @@ def maxima_search(lo: np.ndarray, hi: np.ndarray, points: int = 65, levels: int 
         shift = 0.5 * (y0[vertex] - y2[vertex]) / curvature[vertex]
         step = grid[r, 1] - grid[r, 0]
         t_vertex = grid[r, j[r]] + shift * step
-        value = np.asarray((yield t_vertex), dtype=float)
+        times = best_time.copy()  # one time per bracket: its vertex, or its best point again (value unused)
+        times[r] = t_vertex
+        value = np.asarray((yield times), dtype=float)[r]
         better = value > best_value[r]
         best_value[r[better]] = value[better]
         best_time[r[better]] = t_vertex[better]
@@ -76,13 +90,14 @@ def first_true_search(predicate: Callable[[np.ndarray], np.ndarray], t_false: np
     function's values on them, of which ``predicate(values)`` is the indicator; returns the times."""
     a = np.asarray(t_false, dtype=float)
     b = np.asarray(t_true, dtype=float)
-    rows = np.arange(len(a))
+    first = np.arange(len(a)) * points  # each row's first point in the flattened grid
     for _ in range(levels):
         grid = uniform_grids(a, b, points)
         flags = np.array(predicate((yield grid)), dtype=bool)
         flags[:, -1] = True
-        j = np.argmax(flags[:, 1:], axis=1) + 1
-        a, b = grid[rows, j - 1], grid[rows, j]
+        at_true = first + flags[:, 1:].argmax(axis=1) + 1
+        flat = grid.ravel()
+        a, b = flat.take(at_true - 1), flat.take(at_true)
     return 0.5 * (a + b)
 
 
@@ -94,10 +109,11 @@ def values_at(times: np.ndarray):
 def run(evaluate: Callable[[np.ndarray, list[tuple[int, slice]]], list[np.ndarray]], searches: list) -> list:
     """Drive several searches in lockstep; return their results in order.
 
-    At each round every unfinished search asks for values at an array of times; ``evaluate`` gets all
-    those times concatenated (1-D, s) and ``(search index, slice)`` of each search's part, and returns
-    one array of values per part (each search may evaluate a different function on the same
-    interpolated state).  So a round costs one evaluation whatever the number of searches and brackets.
+    At each round every unfinished search asks for values at an array of times, one row (or one time)
+    per bracket, in the order of its brackets; ``evaluate`` gets all those times concatenated (1-D, s)
+    and ``(search index, slice)`` of each search's part, and returns one array of values per part (each
+    search, or each bracket, may evaluate a different function on the same interpolated state).  So a
+    round costs one evaluation whatever the number of searches and brackets.
     """
     results: list = [None] * len(searches)
     requests = {}

@@ -66,14 +66,16 @@ def refine_maximum(time: np.ndarray, y: np.ndarray, dy: np.ndarray) -> tuple[flo
     time, y, dy = (np.asarray(a, dtype=float) for a in (time, y, dy))
     k = int(np.argmax(y))
     best_value, best_time = float(y[k]), float(time[k])
-    h = np.diff(time)
-    near_sample_max = [i for i in (k - 1, k) if 0 <= i < len(h)]
-    i = np.union1d(np.flatnonzero((dy[:-1] > 0) & (dy[1:] <= 0)), near_sample_max).astype(int)
-    i = i[h[i] > 0]
+    candidate = (dy[:-1] > 0) & (dy[1:] <= 0)  # per interval: the derivative turns from positive
+    candidate[max(k - 1, 0):k + 1] = True  # the intervals beside the sample maximum
+    i = np.flatnonzero(candidate)
+    h = time[i + 1] - time[i]
+    nonempty = h > 0
+    i, h = i[nonempty], h[nonempty]
     if not len(i):
         return best_value, best_time
     # y(s) = a s^3 + b s^2 + c s + d on s in [0, 1]
-    y0, y1, d0, d1 = y[i], y[i + 1], dy[i] * h[i], dy[i + 1] * h[i]
+    y0, y1, d0, d1 = y[i], y[i + 1], dy[i] * h, dy[i + 1] * h
     a = 2 * y0 + d0 - 2 * y1 + d1
     b = -3 * y0 - 2 * d0 + 3 * y1 - d1
     c = d0
@@ -87,29 +89,32 @@ def refine_maximum(time: np.ndarray, y: np.ndarray, dy: np.ndarray) -> tuple[flo
             value = np.where(np.isfinite(s) & (s >= 0.0) & (s <= 1.0) & np.isfinite(value), value, -np.inf)
             j = int(np.argmax(value))
             if value[j] > best_value:
-                best_value, best_time = float(value[j]), float(time[i[j]] + s[j] * h[i[j]])
+                best_value, best_time = float(value[j]), float(time[i[j]] + s[j] * h[j])
     return best_value, best_time
 
 
 def maxima_near_samples(time: np.ndarray, ks: np.ndarray, points: int = 65, levels: int = 4):
     """The searches for the maxima of a function near each sample ``ks[i]``, and how to read them.
 
-    Returns ``(searches, assemble)``: generators for :func:`~mbs_models.results.nested_grids.run` (a
-    :func:`~mbs_models.results.nested_grids.maxima_search` over [t_{k-1}, t_{k+1}] for every k whose
-    bracket is not empty; the value at ``t_k`` itself where it is, equal times at a jump), and
-    ``assemble(results)`` -> ``(values, times)`` arrays in the order of ``ks``.
+    Returns ``(searches, brackets, assemble)``: generators for :func:`~mbs_models.results.nested_grids.run`
+    (a :func:`~mbs_models.results.nested_grids.maxima_search` over [t_{k-1}, t_{k+1}] for every k whose
+    bracket is not empty; the value at ``t_k`` itself where it is, equal times at a jump), the indices
+    into ``ks`` of each search's brackets (increasing), and ``assemble(results)`` -> ``(values, times)``
+    arrays in the order of ``ks``.
     """
     time = np.asarray(time, dtype=float)
     ks = np.asarray(ks, dtype=int)
     lo = time[np.maximum(ks - 1, 0)]
     hi = time[np.minimum(ks + 1, len(time) - 1)]
     open_ = hi > lo
-    searches, kinds = [], []
+    searches, brackets, kinds = [], [], []
     if open_.any():
         searches.append(maxima_search(lo[open_], hi[open_], points, levels))
+        brackets.append(np.flatnonzero(open_))
         kinds.append("open")
     if not open_.all():
         searches.append(values_at(time[ks[~open_]]))
+        brackets.append(np.flatnonzero(~open_))
         kinds.append("closed")
 
     def assemble(results) -> tuple[np.ndarray, np.ndarray]:
@@ -123,7 +128,7 @@ def maxima_near_samples(time: np.ndarray, ks: np.ndarray, points: int = 65, leve
                 values[~open_] = np.asarray(result, dtype=float)
         return values, times
 
-    return searches, assemble
+    return searches, brackets, assemble
 
 
 def refine_function_maxima(f: Callable[[np.ndarray], np.ndarray], time: np.ndarray, ks: np.ndarray,
@@ -136,7 +141,7 @@ def refine_function_maxima(f: Callable[[np.ndarray], np.ndarray], time: np.ndarr
     resolution ~ h / points**levels.  Where the bracket is empty (equal times at a jump) the value is
     ``f(t_k)`` at ``t_k``.
     """
-    searches, assemble = maxima_near_samples(time, ks, points, levels)
+    searches, _, assemble = maxima_near_samples(time, ks, points, levels)
     return assemble(run(lambda times, parts: [f(times[part]) for _, part in parts], searches))
 
 

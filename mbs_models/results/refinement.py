@@ -8,12 +8,15 @@ force is > 0 after the sample before it and the first time it is <= 0 after its 
 (:func:`~mbs_models.results.nested_grids.first_true_search`).  The largest |support force| is refined
 the same way near its largest sample.
 
-All these searches run in lockstep (:func:`~mbs_models.results.nested_grids.run`): each round
-interpolates every body's state once at all the times the searches ask for, and evaluates each
-search's force on its part.  Start and end searches of the episodes whose largest *sample* exceeds
-the threshold (surely impacts) run beside the peak searches; those of episodes that only the refined
-peak lifts above it run in a second round of searches.  Every bracket's arithmetic is that of the
-one-episode search, so the results are those of refining the episodes one by one, bit for bit.
+All these searches run in lockstep (:func:`~mbs_models.results.nested_grids.run`): the peaks of every
+contact's episodes and the support peak are one nested-grid search over all their brackets, the
+starts and ends of every contact's episodes another; each bracket is evaluated with its own function
+(the contact's force, or |S|), each function once per round on the neighbouring brackets it owns.
+Each round interpolates every body's state once at all the times the searches ask for.  Start and
+end searches of the episodes whose largest *sample* exceeds the threshold (surely impacts) run beside
+the peak searches; those of episodes that only the refined peak lifts above it run in a second round
+of searches.  Every bracket's arithmetic is that of the one-episode search, so the results are those
+of refining the episodes one by one, bit for bit.
 """
 
 from __future__ import annotations
@@ -55,28 +58,35 @@ class Episodes:
                 for a, b, p, tp in zip(*(c.tolist() for c in columns))]
 
 
-def _crossing_search(time: np.ndarray, first: np.ndarray, last: np.ndarray, opens: np.ndarray, closes: np.ndarray):
-    """Start (after sample first-1) and end (after sample last) searches of the episodes ``opens``/``closes``."""
-    closing = np.concatenate([np.zeros(len(opens), dtype=bool), np.ones(len(closes), dtype=bool)])[:, None]
+def _crossing_brackets(time: np.ndarray, first: np.ndarray, last: np.ndarray, opens: np.ndarray,
+                       closes: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(lo, hi, closing)`` of the start searches (after sample first-1) of the episodes ``opens`` and
+    the end searches (after sample last) of the episodes ``closes``, in that order."""
+    closing = np.concatenate([np.zeros(len(opens), dtype=bool), np.ones(len(closes), dtype=bool)])
     lo = np.concatenate([time[first[opens] - 1], time[last[closes]]])
     hi = np.concatenate([time[first[opens]], time[last[closes] + 1]])
-    # True where the force is > 0 (an onset) or <= 0 (a release)
-    return first_true_search(lambda force: (force > 0.0) != closing, lo, hi)
+    return lo, hi, closing
 
 
 class _Rounds:
-    """Searches with the function each evaluates on the interpolated state ``(x, v, t)``, run in lockstep."""
+    """Searches over brackets, each bracket with the function its values come from, run in lockstep.
+
+    A search is added with its groups of brackets: ``[(function, count), ...]`` in bracket order, each
+    ``function(x, v, t)`` of per-body positions (m), velocities (m/s) and times (s).  The functions are
+    elementwise in the times, so each is evaluated once per round on every run of neighbouring times
+    that it owns (one contact's peak and crossing brackets), whatever the searches they belong to.
+    """
 
     def __init__(self, interp):
         self.interp = interp
         self.searches: list = []
-        self.functions: list = []
+        self.groups: list[list[tuple]] = []
 
-    def add(self, searches, function) -> slice:
-        start = len(self.searches)
-        self.searches += list(searches)
-        self.functions += [function] * len(searches)
-        return slice(start, len(self.searches))
+    def add(self, search, groups: list[tuple]) -> int:
+        """Add ``search`` with its groups of brackets; return its index among the results of :meth:`run`."""
+        self.searches.append(search)
+        self.groups.append([(function, int(count)) for function, count in groups if count])
+        return len(self.searches) - 1
 
     def run(self) -> list:
         if not self.searches:
@@ -84,13 +94,32 @@ class _Rounds:
 
         def evaluate(times, parts):
             x, v = self.interp.state(times)
-            out = []
-            for index, part in parts:
-                out.append(self.functions[index]({n: a[part] for n, a in x.items()},
-                                                 {n: a[part] for n, a in v.items()}, times[part]))
-            return out
+            values = np.empty(len(times))
+            for function, span in _function_spans(self.groups, parts):
+                values[span] = function({n: a[span] for n, a in x.items()}, {n: a[span] for n, a in v.items()},
+                                        times[span])
+            return [values[part] for _, part in parts]
 
         return run(evaluate, self.searches)
+
+
+def _function_spans(groups: list[list[tuple]], parts: list[tuple[int, slice]]) -> list[tuple]:
+    """``(function, span)`` of each maximal run of neighbouring times of a round evaluated by the same
+    function.  ``parts``: ``(search index, slice)`` of each search's times; a search's request has one
+    row (or time) per bracket, so its group of ``count`` brackets covers ``count`` rows of its part."""
+    spans: list[list] = []
+    for index, part in parts:
+        brackets = sum(count for _, count in groups[index])
+        per_bracket = (part.stop - part.start) // brackets
+        start = part.start
+        for function, count in groups[index]:
+            stop = start + count * per_bracket
+            if spans and spans[-1][0] is function and spans[-1][2] == start:
+                spans[-1][2] = stop
+            else:
+                spans.append([function, start, stop])
+            start = stop
+    return [(function, slice(start, stop)) for function, start, stop in spans]
 
 
 def contact_force_function(mechanism, connector):
@@ -113,61 +142,93 @@ def support_magnitude_function(mechanism):
     return magnitude
 
 
+def _add_peak_searches(rounds: _Rounds, time: np.ndarray, groups: list[tuple]):
+    """Add the searches for the maxima of each group's function near each of its samples ``ks``
+    (``groups``: ``[(function, ks), ...]``); return ``assemble(results)`` -> ``[(values, times), ...]`` per group."""
+    if not groups:
+        return lambda results: []
+    counts = [len(ks) for _, ks in groups]
+    bounds = np.concatenate([[0], np.cumsum(counts)])
+    searches, brackets, assemble = maxima_near_samples(time, np.concatenate([ks for _, ks in groups]))
+    indices = []
+    for search, chosen in zip(searches, brackets):
+        owned = np.diff(np.searchsorted(chosen, bounds))  # brackets of each group in this search
+        indices.append(rounds.add(search, [(function, n) for (function, _), n in zip(groups, owned)]))
+
+    def read(results) -> list[tuple[np.ndarray, np.ndarray]]:
+        values, times = assemble([results[i] for i in indices])
+        return [(values[a:b], times[a:b]) for a, b in zip(bounds[:-1], bounds[1:])]
+
+    return read
+
+
+def _add_crossing_search(rounds: _Rounds, groups: list[tuple]):
+    """Add one search for the first times each group's function turns > 0 (an onset) or <= 0 (a release)
+    in its brackets (``groups``: ``[(function, (lo, hi, closing)), ...]``); return ``read(results)`` -> the
+    times (s) of each group's brackets, or None if there is no bracket."""
+    counts = [len(lo) for _, (lo, _, _) in groups]
+    if not sum(counts):
+        return None
+    bounds = np.concatenate([[0], np.cumsum(counts)])
+    lo, hi, closing = (np.concatenate([brackets[i] for _, brackets in groups]) for i in range(3))
+    closing = closing[:, None]
+    search = first_true_search(lambda force: (force > 0.0) != closing, lo, hi)
+    index = rounds.add(search, [(function, n) for (function, _), n in zip(groups, counts)])
+    return lambda results: [results[index][a:b] for a, b in zip(bounds[:-1], bounds[1:])]
+
+
 def refine(mechanism, time: np.ndarray, forces: dict[str, np.ndarray], interp, contacts, threshold: float,
            support_sample: int | None = None) -> tuple[dict[str, Episodes], tuple[float, float] | None]:
     """Episodes of each contact in ``contacts`` (their sampled ``forces[name]``, N) and, if
     ``support_sample`` is given, the refined maximum ``(value N, time s)`` of |S| near that sample."""
-    rounds = _Rounds(interp)
-    plans = []
+    sampled, functions = [], []
     for connector in contacts:
         force = forces[connector.name]
         first, last = run_bounds(force > 0.0)
-        k = run_argmax(force, first, last)
-        function = contact_force_function(mechanism, connector)
-        searches, assemble = maxima_near_samples(time, k)
-        peaks = rounds.add(searches, function)
-        surely = force[k] > threshold  # the peak is never below the sample: an impact, unless NaN
-        opens = np.flatnonzero(surely & (first > 0))
-        closes = np.flatnonzero(surely & (last < len(time) - 1))
-        crossings = rounds.add([_crossing_search(time, first, last, opens, closes)], function) \
-            if len(opens) or len(closes) else None
-        plans.append((connector, force, first, last, k, assemble, peaks, crossings, opens, closes))
-    support = None
-    if support_sample is not None:
-        searches, assemble_support = maxima_near_samples(time, [support_sample])
-        support = rounds.add(searches, support_magnitude_function(mechanism))
+        sampled.append((connector, force, first, last, run_argmax(force, first, last)))
+        functions.append(contact_force_function(mechanism, connector))
+    rounds = _Rounds(interp)
+    peak_groups = [(function, k) for function, (_, _, _, _, k) in zip(functions, sampled)]
+    if support_sample is not None:  # first: the contacts' peak and crossing brackets then neighbour
+        peak_groups.insert(0, (support_magnitude_function(mechanism), np.array([support_sample])))
+    read_peaks = _add_peak_searches(rounds, time, peak_groups)
+    surely = []
+    for connector, force, first, last, k in sampled:
+        sure = force[k] > threshold  # the peak is never below the sample: an impact, unless NaN
+        surely.append((np.flatnonzero(sure & (first > 0)), np.flatnonzero(sure & (last < len(time) - 1))))
+    read_crossings = _add_crossing_search(rounds, [
+        (function, _crossing_brackets(time, first, last, opens, closes))
+        for function, (_, _, first, last, _), (opens, closes) in zip(functions, sampled, surely)])
     results = rounds.run()
+    peaks = read_peaks(results)
+    support_peak = None
+    if support_sample is not None:
+        values, times = peaks.pop(0)
+        support_peak = (float(values[0]), float(times[0]))
+    crossings = read_crossings(results) if read_crossings is not None else [None] * len(sampled)
 
     episodes: dict[str, Episodes] = {}
-    late = _Rounds(interp)
-    pending = []
-    for connector, force, first, last, k, assemble, peaks, crossings, opens, closes in plans:
-        peak, t_peak = assemble(results[peaks])
+    lifted = []
+    for (connector, force, first, last, k), (peak, t_peak), (opens, closes), found in zip(
+            sampled, peaks, surely, crossings):
         sample = force[k]
         peak = np.where(sample > peak, sample, peak)  # max(refined, sample): the refined one on ties
         start, end = time[first], time[last]
         strong = peak > threshold
-        if crossings is not None:
-            found = results[crossings.start]
+        if found is not None:
             keep = strong[opens]
             start[opens[keep]] = found[:len(opens)][keep]
             keep = strong[closes]
             end[closes[keep]] = found[len(opens):][keep]
-        late_opens = np.flatnonzero(strong & (force[k] <= threshold) & (first > 0))
-        late_closes = np.flatnonzero(strong & (force[k] <= threshold) & (last < len(time) - 1))
-        if len(late_opens) or len(late_closes):
-            index = late.add([_crossing_search(time, first, last, late_opens, late_closes)],
-                             contact_force_function(mechanism, connector))
-            pending.append((connector.name, index.start, late_opens, late_closes))
+        late = strong & (force[k] <= threshold)
+        lifted.append((np.flatnonzero(late & (first > 0)), np.flatnonzero(late & (last < len(time) - 1))))
         episodes[connector.name] = Episodes(first, last, k, peak, t_peak, start, end)
-    if pending:
-        late_results = late.run()
-        for name, index, late_opens, late_closes in pending:
-            found = late_results[index]
-            episodes[name].start[late_opens] = found[:len(late_opens)]
-            episodes[name].end[late_closes] = found[len(late_opens):]
-    support_peak = None
-    if support is not None:
-        values, times = assemble_support(results[support])
-        support_peak = (float(values[0]), float(times[0]))
+    late_rounds = _Rounds(interp)
+    read_late = _add_crossing_search(late_rounds, [
+        (function, _crossing_brackets(time, first, last, opens, closes))
+        for function, (_, _, first, last, _), (opens, closes) in zip(functions, sampled, lifted)])
+    if read_late is not None:
+        for (connector, *_), (opens, closes), found in zip(sampled, lifted, read_late(late_rounds.run())):
+            episodes[connector.name].start[opens] = found[:len(opens)]
+            episodes[connector.name].end[closes] = found[len(opens):]
     return episodes, support_peak

@@ -8,6 +8,7 @@ basis polynomials.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -29,7 +30,7 @@ class Samples:
 class Interpolant:
     """Hermite interpolation of every body's state between samples.
 
-    ``x[name]``, ``v[name]``: one body's position and velocity; :meth:`state` and :meth:`on_intervals`
+    ``x[name]``, ``v[name]``: one body's position and velocity; :meth:`state` and :meth:`at_fractions`
     give every body's at once (one interval search and one set of basis polynomials for all; the same
     values as the single trajectories, bit for bit).
     """
@@ -37,12 +38,22 @@ class Interpolant:
     def __init__(self, s: Samples):
         self.time = s.time
         self.names = list(s.positions)
-        self.x = {name: HermiteTrajectory(s.time, s.positions[name], s.velocities[name]) for name in s.positions}
-        self.v = {name: HermiteTrajectory(s.time, s.velocities[name], s.accelerations[name]) for name in s.positions}
-        self._stack = HermiteStack(s.time, np.array([s.positions[n] for n in self.names]
-                                                     + [s.velocities[n] for n in self.names]).reshape(-1, len(s.time)),
-                                   np.array([s.velocities[n] for n in self.names]
-                                            + [s.accelerations[n] for n in self.names]).reshape(-1, len(s.time)))
+        self._samples = s
+        self._stack = HermiteStack.chain(s.time, [[s.positions[n] for n in self.names],
+                                                  [s.velocities[n] for n in self.names],
+                                                  [s.accelerations[n] for n in self.names]])
+
+    @cached_property
+    def x(self) -> dict[str, HermiteTrajectory]:
+        """Each body's position (m) interpolated from its velocity."""
+        s = self._samples
+        return {name: HermiteTrajectory(s.time, s.positions[name], s.velocities[name]) for name in self.names}
+
+    @cached_property
+    def v(self) -> dict[str, HermiteTrajectory]:
+        """Each body's velocity (m/s) interpolated from its acceleration."""
+        s = self._samples
+        return {name: HermiteTrajectory(s.time, s.velocities[name], s.accelerations[name]) for name in self.names}
 
     def _split(self, values) -> tuple[dict, dict]:
         n = len(self.names)
@@ -53,9 +64,9 @@ class Interpolant:
         """Every body's position (m) and velocity (m/s) at times ``t`` (s, any shape)."""
         return self._split(self._stack(t))
 
-    def on_intervals(self, fractions) -> tuple[dict, dict]:
-        """Every body's position and velocity at ``t_i + f h_i``, shape (intervals, fractions) each."""
-        return self._split(self._stack.on_intervals(fractions))
+    def at_fractions(self, fractions) -> tuple[dict, dict]:
+        """Every body's position and velocity at ``t_i + f h_i``, shape (fractions, intervals) each."""
+        return self._split(self._stack.at_fractions(fractions))
 
     def positions(self, t) -> dict:
         return self.state(t)[0]
