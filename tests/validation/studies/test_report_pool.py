@@ -10,10 +10,11 @@ from validation.studies.report import ReportOptions, results_json, write_report
 
 
 def _numbers(data: dict) -> dict:
-    """results.json without what may differ between runs: timings, the machine, the worker count."""
+    """results.json without what may differ between runs: timings, the machine, the worker count, the minute the
+    report was made (the two runs below can straddle a minute)."""
     def strip(value):
         if isinstance(value, dict):
-            return {k: strip(v) for k, v in value.items() if k not in ("timings", "machine", "wall_time", "workers")}
+            return {k: strip(v) for k, v in value.items() if k not in ("timings", "machine", "wall_time", "workers", "date")}
         if isinstance(value, list):
             return [strip(v) for v in value]
         return value
