@@ -57,7 +57,7 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
-sys.path.insert(0, str(Path(__file__).resolve().parent))  # bench_throughput, bench_reuse
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # bench_throughput, bench_reuse, profile_solve
 
 from bench_reuse import rss_bytes  # noqa: E402
 
@@ -231,31 +231,12 @@ def element_costs(scene, end_time: float, repeats: int) -> tuple[dict, dict]:
 
 def exudyn_floor_round(scene, end_time: float) -> tuple[float, int]:
     """Exudyn's own cost per step for this scene's system, nothing of the product's: the same assembled items with
-    Exudyn's built-in linear law in place of every user function (the stiffness/damping the items already have),
-    no sensor stored, no pre-step function, the ``standard`` settings.  Returns (solve wall time s, steps): the
-    motion differs from the scene's, so compare per step."""
-    import exudyn
+    Exudyn's built-in linear law in place of every user function, no sensor stored, no pre-step function, the
+    ``standard`` settings (:func:`profile_solve.run`).  Returns (solve wall time s, steps): the motion differs from
+    the scene's, so compare per step."""
+    import profile_solve
 
-    from mbs_models.engine.accuracy import solver_settings_for
-    from mbs_models.engine.assembly import assemble
-    from mbs_models.engine.simulation import exudyn_simulation_settings
-
-    settings = solver_settings_for("standard")
-    assembly = assemble(scene, settings.user_functions)
-    try:
-        mbs = assembly.mbs
-        for name in assembly.user_function_connectors:
-            mbs.SetObjectParameter(assembly.connectors[name], "springForceUserFunction", 0)
-        for index in assembly.sensors.values():
-            mbs.SetSensorParameter(index, "storeInternal", False)
-        ss = exudyn_simulation_settings(settings, end_time)
-        exudyn.config.printToConsole = False
-        start = time.perf_counter()
-        mbs.SolveDynamic(ss, solverType=getattr(exudyn.DynamicSolverType, settings.solver))
-        elapsed = time.perf_counter() - start
-        return elapsed, int(mbs.sys["dynamicSolver"].it.currentStepIndex)
-    finally:
-        assembly.close()
+    return profile_solve.run(scene, "symbolic", pre_step=False, sensors=False, laws=False, end_time=end_time)
 
 
 # ------------------------------------------------------------------------------------------------ memory

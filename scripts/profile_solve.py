@@ -39,7 +39,11 @@ from mbs_models.engine.simulation import _pre_step_function, exudyn_simulation_s
 END = 10.0
 
 
-def run(scene, backend: str, pre_step: bool, sensors: bool, laws: bool = True) -> tuple[float, int]:
+def run(scene, backend: str, pre_step: bool, sensors: bool, laws: bool = True,
+        end_time: float = END) -> tuple[float, int]:
+    """One ``standard`` solve of ``scene`` to ``end_time`` (s) with or without the pre-step function, stored sensors
+    and the user functions (``laws``: False puts Exudyn's built-in linear law in their place); returns (solve wall
+    time s, steps)."""
     settings = solver_settings_for("standard", backend)
     assembly = assemble(scene, backend)
     try:
@@ -51,8 +55,8 @@ def run(scene, backend: str, pre_step: bool, sensors: bool, laws: bool = True) -
             for index in assembly.sensors.values():
                 mbs.SetSensorParameter(index, "storeInternal", False)
         if pre_step:
-            mbs.SetPreStepUserFunction(_pre_step_function(assembly, StepBudget(step_budget(END)), None))
-        ss = exudyn_simulation_settings(settings, END)
+            mbs.SetPreStepUserFunction(_pre_step_function(assembly, StepBudget(step_budget(end_time)), None))
+        ss = exudyn_simulation_settings(settings, end_time)
         exudyn.config.printToConsole = False
         start = time.perf_counter()
         mbs.SolveDynamic(ss, solverType=getattr(exudyn.DynamicSolverType, settings.solver))
