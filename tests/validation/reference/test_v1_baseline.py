@@ -35,6 +35,8 @@ def paper_cases() -> dict:
 
 CASES = paper_cases()
 
+pytestmark = pytest.mark.recorded
+
 
 def test_the_cases_are_the_recorded_ones():
     assert sorted(CASES) == sorted(BASELINE["cases"]) and len(CASES) == 19
