@@ -374,6 +374,7 @@ def optimise(scene: Scene, bounds: Mapping[str, tuple[float, float]], minimise: 
 
     import pandas as pd
 
+    from ..engine.unit_slips import warn_unit_slips
     from .backends import make_backend
     from .point import PointSettings
 
@@ -381,6 +382,7 @@ def optimise(scene: Scene, bounds: Mapping[str, tuple[float, float]], minimise: 
     bounds, constraints, metrics = check_problem(scene, bounds, minimise, constraints, end_time=end_time,
                                                  accuracy=accuracy, seed=seed, popsize=popsize, maxiter=maxiter,
                                                  tol=tol)
+    warn_unit_slips(scene, grid=bounds)  # at the corners of the design space, to the caller of optimise
     swf = early_stop_metrics([minimise, *(c.metric for c in constraints)]) if stop_when_final else ()
     settings = PointSettings(end_time=end_time, accuracy=accuracy, stop_when_final=swf)
 

@@ -86,3 +86,14 @@ def test_the_summary_prints_one_unit_system_without_plot_markup(tmp_path, capsys
         assert words[5] == "value" and words[7] == unit
         assert float(words[6]) == pytest.approx(constraint["value"], rel=1e-5)
         assert (float(words[6]) <= limit if op == "<=" else float(words[6]) >= limit) and words[8] == "(met)"
+
+
+def test_a_barrel_mass_in_tonnes_warns_on_one_line(tmp_path, capsys):
+    from mbs_models import model_i, scene_to_toml
+
+    path = tmp_path / "tonnes.toml"
+    path.write_text(scene_to_toml(model_i().with_changes(**{"barrel.mass": 5.6})))
+    main(["optimise", str(path), "--vary", "contact.gap=0:0.1", "--minimise", "max_barrel_displacement",
+          "--end-time", "0.05", "--accuracy", "draft", "--out", str(tmp_path / "o"), *SMALL])
+    warned = [line for line in capsys.readouterr().err.splitlines() if "warning" in line]
+    assert len(warned) == 1 and warned[0].startswith("recoil: warning: barrel.mass = 5.6 kg")
