@@ -265,20 +265,22 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _show_warning(message, category, filename, lineno, file=None, line=None, *, _default=warnings.showwarning):
-    """A :class:`UnitWarning` as one line on stderr (``recoil: warning: KEY = VALUE ...``); others as Python
-    shows them."""
-    if issubclass(category, UnitWarning):
-        print(f"recoil: warning: {message}", file=sys.stderr, flush=True)
-    else:
-        _default(message, category, filename, lineno, file, line)
+def _one_line_unit_warnings(show_other):
+    """A ``warnings.showwarning`` that prints a :class:`UnitWarning` as one line on stderr (``recoil: warning:
+    KEY = VALUE ...``) and passes every other warning to ``show_other``."""
+    def show(message, category, filename, lineno, file=None, line=None):
+        if issubclass(category, UnitWarning):
+            print(f"recoil: warning: {message}", file=sys.stderr, flush=True)
+        else:
+            show_other(message, category, filename, lineno, file, line)
+    return show
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``recoil`` console script; returns the exit code."""
     with warnings.catch_warnings():
         warnings.simplefilter("default", UnitWarning)  # each distinct slip once, whatever the user's filters
-        warnings.showwarning = _show_warning
+        warnings.showwarning = _one_line_unit_warnings(warnings.showwarning)
         return _main(argv)
 
 
