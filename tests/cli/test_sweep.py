@@ -144,3 +144,7 @@ def test_a_sweep_over_gaps_in_millimetres_warns_once_before_it_runs(tmp_path, ca
     [line] = captured.err.strip().splitlines()
     assert line.startswith("recoil: warning: absorber.contact.gap = 40 m is beyond")
     assert json.loads(captured.out)["points"] == 2  # and the sweep ran every point
+    assert main(["sweep", "model_ii", "--param", "contact.gap=0,40", "--out", str(out), "--end-time", "0.2",
+                 "--accuracy", "draft", "--workers", "1"]) == 0  # resumed: the text summary
+    captured = capsys.readouterr()
+    assert "$" not in captured.out + captured.err
