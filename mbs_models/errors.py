@@ -6,6 +6,9 @@ Two kinds of failure matter to users and are kept apart:
   solver setting).  It always names the offending key so the message can be shown as one line.
 * :class:`SimulationError` -- the input was valid but the *solve* failed (the solver stopped early,
   produced NaN, or a user function raised).  Nothing half-finished is ever returned as a result.
+
+One warning category: :class:`UnitWarning` -- the input is valid but a magnitude is implausible (a unit
+slip?); the run goes on.
 """
 
 from __future__ import annotations
@@ -34,3 +37,9 @@ class SceneError(RecoilError, ValueError):
 
 class SimulationError(RecoilError, RuntimeError):
     """A solve failed; the message says why (early stop, NaN, exception in a user function...)."""
+
+
+class UnitWarning(UserWarning):
+    """A magnitude implausible for a recoil mechanism -- most likely a unit slip (a mass in tonnes, a gap
+    in mm, a pulse in ms and kN).  The message names the key, the value, the plausible range and the
+    likely slip; nothing is clamped or refused (:mod:`mbs_models.engine.unit_slips`)."""

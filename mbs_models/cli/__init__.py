@@ -1,7 +1,9 @@
 """The ``recoil`` command line.
 
 Exit codes: 0 success; 1 a simulation or check failed; 2 bad input (one line on stderr naming the
-problem, never a traceback for user mistakes).
+problem, never a traceback for user mistakes).  A :class:`~mbs_models.errors.UnitWarning` (an implausible
+magnitude, a contact that can never close: :mod:`mbs_models.engine.unit_slips`) is one line on stderr,
+``recoil: warning: ...``, and the command goes on.
 """
 
 from __future__ import annotations
@@ -11,11 +13,12 @@ import json
 import os
 import sys
 import time
+import warnings
 from pathlib import Path
 from typing import Sequence
 
 from .. import __version__
-from ..errors import SceneError, SimulationError
+from ..errors import SceneError, SimulationError, UnitWarning
 from ..scene import load_scene
 from . import run
 from .sweep import add_set_argument, add_sweep_parser, apply_sets
@@ -44,13 +47,33 @@ def _progress():
 
 
 def _resolve_scene(path: str):
-    """A scene file path, or the name of a shipped scene (``simplified``, ``model_i``, ``model_ii``)."""
+    """A scene file path, or the name of a shipped scene (``simplified``, ``model_i``, ``model_ii``: see
+    ``recoil scenes``); a name that is neither gets a "did you mean" over the shipped names."""
+    from ..scenes import closest_scene, list_scenes, scene_path, unknown_scene
+
     candidate = Path(path)
-    if not candidate.exists() and candidate.suffix == "" and "/" not in path:
-        from ..scenes import list_scenes, scene_path
+    if candidate.exists() or "/" in path or os.sep in path or candidate.suffix not in ("", ".toml"):
+        return load_scene(candidate)  # a path: its own errors (not found, malformed, ...)
+    if candidate.suffix == "":
         if path in list_scenes():
-            candidate = scene_path(path)
+            return load_scene(scene_path(path))
+        raise SceneError("", f"no scene file {path!r} and {unknown_scene(path)}")
+    close = closest_scene(candidate.stem)  # model_ii.toml or model_iii.toml, not in this directory
+    if close is not None:
+        raise SceneError("", f"scene file not found: {path}; did you mean the shipped scene {close!r} (a name, "
+                             f"without .toml)?")
     return load_scene(candidate)
+
+
+def _cmd_scenes(args) -> int:
+    from ..scenes import describe_scenes, scene_path
+
+    rows = [[name, str(scene_path(name)), description] if args.path else [name, description]
+            for name, description in describe_scenes()]
+    widths = [max(len(row[i]) for row in rows) for i in range(len(rows[0]) - 1)]
+    for row in rows:
+        print("  ".join([f"{cell:{width}s}" for cell, width in zip(row, widths)] + row[-1:]))
+    return EXIT_OK
 
 
 def _cmd_paper(args) -> int:
@@ -81,7 +104,6 @@ def _cmd_validate(args) -> int:
     from validation.studies.compare import compare
 
     scene = apply_sets(_resolve_scene(args.scene), args.set)
-    run.warn_out_of_reach(scene)
     comparison = compare(scene, args.end_time, args.accuracy, impact_threshold=args.impact_threshold)
     if args.json:
         print(json.dumps(comparison.to_dict(), indent=2, allow_nan=False))
@@ -178,9 +200,14 @@ def build_parser() -> argparse.ArgumentParser:
 
     run.add_parser(sub, ACCURACY_HELP)
 
+    scenes = sub.add_parser("scenes", help="list the shipped scenes (names for run, validate, sweep, ...) with "
+                                           "a one-line description each")
+    scenes.add_argument("--path", action="store_true", help="also print each scene's file path (copy it to edit)")
+    scenes.set_defaults(handler=_cmd_scenes)
+
     validate = sub.add_parser("validate", help="engine vs the independent scipy reference for one scene "
                                                "(exit code 1 if a tolerance is exceeded)")
-    validate.add_argument("scene", help="scene TOML file, or the name of a shipped scene (see the README: model_i, model_ii, two_absorbers, ...)")
+    validate.add_argument("scene", help="scene TOML file, or the name of a shipped scene (model_i, model_ii, two_absorbers, ...: 'recoil scenes' lists them)")
     validate.add_argument("--end-time", type=float, default=10.0, help="simulated time in s (default 10)")
     validate.add_argument("--accuracy", default="standard", choices=("draft", "standard", "reference"),
                           help=ACCURACY_HELP)
@@ -238,8 +265,26 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _one_line_unit_warnings(show_other):
+    """A ``warnings.showwarning`` that prints a :class:`UnitWarning` as one line on stderr (``recoil: warning:
+    KEY = VALUE ...``) and passes every other warning to ``show_other``."""
+    def show(message, category, filename, lineno, file=None, line=None):
+        if issubclass(category, UnitWarning):
+            print(f"recoil: warning: {message}", file=sys.stderr, flush=True)
+        else:
+            show_other(message, category, filename, lineno, file, line)
+    return show
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``recoil`` console script; returns the exit code."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("default", UnitWarning)  # each distinct slip once, whatever the user's filters
+        warnings.showwarning = _one_line_unit_warnings(warnings.showwarning)
+        return _main(argv)
+
+
+def _main(argv: Sequence[str] | None) -> int:
     try:
         args = build_parser().parse_args(argv)
         return args.handler(args)

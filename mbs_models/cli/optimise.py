@@ -62,7 +62,7 @@ def add_parser(sub) -> None:
     """Register the ``optimise`` subcommand on the ``recoil`` parser's subparsers."""
     opt = sub.add_parser("optimise", help="the design within bounds that minimises a metric, subject to "
                                           "constraints on metrics (differential evolution)")
-    opt.add_argument("scene", help="scene TOML file or shipped scene (model_i, model_ii, ...)")
+    opt.add_argument("scene", help="scene TOML file or shipped scene (model_i, model_ii, ...: 'recoil scenes' lists them)")
     opt.add_argument("--vary", action="append", metavar="KEY=LOW:HIGH",
                      help="a dotted scene key and its bounds in SI units, e.g. contact.gap=0:0.12 (repeatable)")
     opt.add_argument("--minimise", "--minimize", required=True, metavar="METRIC",

@@ -1,14 +1,14 @@
 """``recoil run``: simulate one scene, print its metrics, optionally write the plot and the time histories.
 
 Every output is checked before the solve (exit 2, nothing written, for a figure format other than
-png/pdf/svg or a missing or unwritable directory), and contacts that can never close are reported on
-stderr (:func:`mbs_models.engine.reach.contacts_out_of_reach`) before the solve too.
+png/pdf/svg or a missing or unwritable directory); unit slips (implausible magnitudes, contacts that can
+never close: :mod:`mbs_models.engine.unit_slips`) are warned of by ``simulate`` before it solves, one line
+each on stderr.
 """
 
 from __future__ import annotations
 
 import json
-import sys
 
 
 def add_parser(sub, accuracy_help: str) -> None:
@@ -16,8 +16,8 @@ def add_parser(sub, accuracy_help: str) -> None:
     from .sweep import add_set_argument
 
     run = sub.add_parser("run", help="simulate one scene and print its metrics")
-    run.add_argument("scene", help="scene TOML file, or the name of a shipped scene (see the README: model_i, "
-                                   "model_ii, two_absorbers, ...)")
+    run.add_argument("scene", help="scene TOML file, or the name of a shipped scene (model_i, model_ii, "
+                                   "two_absorbers, ...: 'recoil scenes' lists them)")
     run.add_argument("--end-time", type=float, default=10.0, help="simulated time in s (default 10)")
     run.add_argument("--accuracy", default="standard", choices=("draft", "standard", "reference"),
                      help=accuracy_help)
@@ -36,14 +36,6 @@ def add_parser(sub, accuracy_help: str) -> None:
     run.set_defaults(handler=command)
 
 
-def warn_out_of_reach(scene) -> None:
-    """One line on stderr per contact that can never close (a gap in mm instead of m...)."""
-    from ..engine.reach import contacts_out_of_reach
-
-    for found in contacts_out_of_reach(scene):
-        print(f"recoil: warning: {found.message()}", file=sys.stderr, flush=True)
-
-
 def command(args) -> int:
     from ..engine.simulation import simulate
     from ..outputs import check_output_file
@@ -57,7 +49,6 @@ def command(args) -> int:
         check_output_file(args.plot, key="--plot")
     if args.csv:
         check_output_file(args.csv, key="--csv")
-    warn_out_of_reach(scene)
     result = simulate(scene, args.end_time, args.accuracy, user_functions=args.user_functions,
                       impact_threshold=args.impact_threshold)
     if args.plot:

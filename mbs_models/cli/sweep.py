@@ -49,7 +49,8 @@ def add_sweep_parser(sub) -> None:
     """Register ``recoil sweep`` on the subcommands ``sub``."""
     sweep = sub.add_parser("sweep", help="simulate a scene over a grid of parameter values into a CSV/Parquet "
                                          "table (resumable; local processes or a Dask cluster)")
-    sweep.add_argument("scene", help="scene TOML file, or the name of a shipped scene (model_i, model_ii, ...)")
+    sweep.add_argument("scene", help="scene TOML file, or the name of a shipped scene (model_i, model_ii, ...: "
+                                         "'recoil scenes' lists them)")
     sweep.add_argument("--param", action="append", default=[], metavar="KEY=SPEC", required=True,
                        help="a dotted scene key and its values: a list 100,500,1000 or a range START:STOP:COUNT "
                             "(both ends included); repeat for a grid, e.g. --param absorber.mass=100,500 "

@@ -43,6 +43,7 @@ from .final_metrics import (ENERGY_SLACK, FINAL_METRICS, STOP_END_TIME, STOP_ENE
                             FinalityTracker, check_metric_names, dissipative, largest_energy_rise)
 from .guard import StepBudget, step_budget
 from .mechanism import Mechanism
+from .unit_slips import warn_unit_slips
 
 #: Longest simulated time accepted, in s.
 MAX_END_TIME = 1.0e4
@@ -477,9 +478,14 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
 
     Warns
     -----
+    UnitWarning (:mod:`mbs_models.errors`), before the solve: a magnitude implausible for a recoil
+        mechanism (a barrel mass in tonnes, a pulse in ms or kN) or a contact that can never close (a gap
+        in mm), naming the scene key (:mod:`mbs_models.engine.unit_slips`); the run goes on.
     stability.AccuracyWarning: a fixed step resolves impacts with fewer than 10 steps, or the energy
         balance is off by more than 1 % of the initial energy.
     """
+    if isinstance(scene, Scene):  # anything else: simulate_with's SceneError
+        warn_unit_slips(scene, stacklevel=2)
     return simulate_with(FRESH_MODELS, scene, end_time, accuracy, user_functions=user_functions,
                          impact_threshold=impact_threshold, stop_when_final=stop_when_final)
 

@@ -64,6 +64,29 @@ def _absorber_entries(data: dict, version: int) -> list[tuple[str, Any]]:
     raise SceneError("absorber", f"must be a table [absorber], got {type(content).__name__}")
 
 
+def version_2_tables(data: dict) -> list[tuple[str, str]]:
+    """The tables of a parsed scene file that only version 2 has: ``(key, the table as the file spells it)``
+    for ``[[absorber]]``, ``[absorber.contact]``, ``[firing.pulse]`` and every table of a later version
+    (``[recoil_brake]``, ``[recuperator]``, ``[burst]``, ``[cradle]``, the stops), in the file's order."""
+    found = []
+    for table, content in data.items():
+        cls = ELEMENT_TABLES.get(table)
+        if cls is None:
+            continue
+        if cls.SINCE_VERSION > 1:
+            found.append((table, f"[{table}]"))
+        if isinstance(content, list):
+            found.append((table, f"[[{table}]]"))
+        for entry in content if isinstance(content, list) else [content]:
+            if not isinstance(entry, dict):
+                continue
+            for name, nested in cls.NESTED.items():
+                # a version-1 absorber's contact is the top-level [contact]; the nested one is version 2's
+                if name in entry and (nested.SINCE_VERSION > 1 or cls.MANY):
+                    found.append((f"{table}.{name}", f"[{table}.{name}]"))
+    return list(dict.fromkeys(found))
+
+
 def scene_from_dict(data: dict[str, Any]) -> Scene:
     """Build a validated :class:`Scene` from a parsed TOML mapping (version 1 or 2)."""
     if not isinstance(data, dict):
@@ -73,6 +96,12 @@ def scene_from_dict(data: dict[str, Any]) -> Scene:
         if key not in allowed:
             raise SceneError(key, f"unknown key{suggestion(key, allowed)}")
     version = _version(data)
+    newer = version_2_tables(data) if version == 1 else []
+    if newer:  # before the version-1 checks: a version-2 file without its version key is no version-1 file
+        said = "says version = 1" if "version" in data else "has no version key"
+        raise SceneError(newer[0][0], f"the file uses tables of a version-2 scene "
+                                      f"({', '.join(spelled for _, spelled in newer)}) but {said}: "
+                                      f"add version = 2 at the top")
     if version == 1:
         for table in _REQUIRED_V1:
             if table not in data:
@@ -207,5 +236,5 @@ def mapping_to_toml(data: dict[str, Any]) -> str:
     return "\n".join(lines) + "\n"
 
 
-__all__ = ["FORMAT_VERSION", "FORMAT_VERSIONS", "load_scene", "scene_from_dict", "scene_to_dict", "scene_to_toml",
+__all__ = ["FORMAT_VERSION", "FORMAT_VERSIONS", "load_scene", "version_2_tables", "scene_from_dict", "scene_to_dict", "scene_to_toml",
            "mapping_to_toml"]

@@ -199,22 +199,22 @@ class OptimisationResult:
         }
 
     def summary(self) -> str:
-        """A few lines for the terminal."""
-        from ..results.sweep_plots import metric_label, parameter_label
+        """A few lines for the terminal, every value in SI units as typed on the command line (the limit
+        and the value of a constraint in the same unit; plain unit strings, no plot markup)."""
+        from ..results.units import metric_si_unit, parameter_si_unit
 
-        label, factor = metric_label(self.minimise)
-        value = "none" if self.objective is None else f"{self.objective * factor:.6g}"
+        unit = metric_si_unit(self.minimise)
+        value = "none" if self.objective is None else f"{self.objective:.6g} {unit}"
         lines = [f"{'feasible' if self.feasible else 'NO FEASIBLE DESIGN FOUND; least violating'} design: "
-                 f"{self.minimise} = {value} ({label.rsplit('[', 1)[-1].rstrip(']')})"]
+                 f"{self.minimise} = {value}"]
         for key, v in self.parameters.items():
-            p_label, p_factor = parameter_label(key)
-            lines.append(f"  {key:32s} {v * p_factor:.6g} [{p_label.rsplit('[', 1)[-1]}")
-        for c in self.constraint_values:
-            state = "met" if c["satisfied"] else "VIOLATED"
-            c_label, c_factor = metric_label(c["metric"])
-            value = "none (failed)" if c["value"] is None else f"{c['value'] * c_factor:.6g}"
-            lines.append(f"  constraint {c['constraint']:36s} value {value} {c_label.rsplit('[', 1)[-1].rstrip(']')}"
-                         f" ({state})")
+            lines.append(f"  {key:32s} {v:.6g} {parameter_si_unit(key)}")
+        for c, entry in zip(self.constraints, self.constraint_values):
+            state = "met" if entry["satisfied"] else "VIOLATED"
+            unit = metric_si_unit(c.metric)
+            value = "none (failed)" if entry["value"] is None else f"{entry['value']:.6g} {unit}"
+            bound = f"{c.metric} {'<=' if c.upper else '>='} {c.limit:g} {unit}"
+            lines.append(f"  constraint {bound:40s} value {value} ({state})")
         failed = int((self.history["status"] != "ok").sum())
         lines.append(f"  {self.evaluations} evaluations ({failed} failed) in {self.generations} generations, "
                      f"{self.wall_time:.1f} s; scipy: {self.message}")
@@ -374,6 +374,7 @@ def optimise(scene: Scene, bounds: Mapping[str, tuple[float, float]], minimise: 
 
     import pandas as pd
 
+    from ..engine.unit_slips import warn_unit_slips
     from .backends import make_backend
     from .point import PointSettings
 
@@ -381,6 +382,7 @@ def optimise(scene: Scene, bounds: Mapping[str, tuple[float, float]], minimise: 
     bounds, constraints, metrics = check_problem(scene, bounds, minimise, constraints, end_time=end_time,
                                                  accuracy=accuracy, seed=seed, popsize=popsize, maxiter=maxiter,
                                                  tol=tol)
+    warn_unit_slips(scene, grid=bounds)  # at the corners of the design space, to the caller of optimise
     swf = early_stop_metrics([minimise, *(c.metric for c in constraints)]) if stop_when_final else ()
     settings = PointSettings(end_time=end_time, accuracy=accuracy, stop_when_final=swf)
 

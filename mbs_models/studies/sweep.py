@@ -222,6 +222,7 @@ def run_sweep(scene: Scene, params, *, end_time: float = 10.0, accuracy: str | S
     from ..engine.accuracy import solver_settings_for
     from ..engine.final_metrics import check_metric_names
     from ..engine.simulation import _check_arguments
+    from ..engine.unit_slips import warn_unit_slips
     from . import backends as _backends
     from .grid import make_grid
     from .point import PointSettings, evaluate_batch, metric_columns
@@ -233,6 +234,7 @@ def run_sweep(scene: Scene, params, *, end_time: float = 10.0, accuracy: str | S
     solver_settings_for(accuracy)
     settings = PointSettings(float(end_time), accuracy, check_metric_names(stop_when_final), float(impact_threshold))
     grid = make_grid(scene, params)
+    warn_unit_slips(scene, grid=dict(zip(grid.keys, grid.values)))  # to the caller of run_sweep
     if batch_size is not None and (isinstance(batch_size, bool) or not isinstance(batch_size, int) or batch_size < 1):
         raise SceneError("batch_size", f"must be a whole number >= 1, got {batch_size!r}")
     if scheduler is None:

@@ -189,3 +189,70 @@ def test_output_piped_into_a_reader_that_stops_gives_no_traceback():
     proc.stdout.close()  # before the process writes anything (it is still importing)
     err = proc.stderr.read().decode()
     assert proc.wait() == 0 and "Traceback" not in err and "BrokenPipe" not in err, err
+
+
+def _one_error_line(capsys) -> str:
+    captured = capsys.readouterr()
+    lines = captured.err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("recoil: error:"), captured.err
+    assert "Traceback" not in captured.err and captured.out == ""
+    return lines[0]
+
+
+@pytest.mark.parametrize("command", ["run", "validate", "sweep", "optimise"])
+def test_a_misspelt_shipped_scene_gets_a_did_you_mean(capsys, tmp_path, monkeypatch, command):
+    monkeypatch.chdir(tmp_path)  # no file of that name here
+    extra = {"sweep": ["--param", "contact.gap=0,0.01", "--out", "s.csv"],
+             "optimise": ["--vary", "contact.gap=0:0.1", "--minimise", "max_barrel_displacement"]}.get(command, [])
+    assert main([command, "two_absorber", *extra]) == 2
+    line = _one_error_line(capsys)
+    assert "'two_absorber'" in line and "did you mean 'two_absorbers'?" in line
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_name_far_from_every_shipped_scene_lists_them(capsys, tmp_path, monkeypatch):
+    from pathlib import Path
+
+    import mbs_models.scenes
+
+    shipped = sorted(p.stem for p in Path(mbs_models.scenes.__file__).parent.glob("*.toml"))
+    monkeypatch.chdir(tmp_path)
+    assert main(["run", "xyzzy"]) == 2
+    line = _one_error_line(capsys)
+    assert "did you mean" not in line and line.endswith(", ".join(shipped))
+
+
+def test_a_shipped_name_with_toml_that_is_not_here_points_at_the_name(capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert main(["run", "model_ii.toml"]) == 2
+    assert "the shipped scene 'model_ii'" in _one_error_line(capsys)
+    assert main(["run", "elsewhere/model_ii.toml"]) == 2  # a path: its own error
+    assert "scene file not found: elsewhere/model_ii.toml" in _one_error_line(capsys)
+
+
+def test_a_version_2_scene_without_its_version_key_is_one_line_exit_2(capsys, tmp_path):
+    from mbs_models.scenes import scene_path
+
+    path = tmp_path / "two.toml"
+    path.write_text(scene_path("two_absorbers").read_text().replace("version = 2", ""))
+    assert main(["run", str(path)]) == 2
+    line = _one_error_line(capsys)
+    assert "[[absorber]]" in line and line.endswith("add version = 2 at the top")
+
+
+def test_scenes_lists_every_shipped_scene_with_its_name(capsys):
+    from pathlib import Path
+
+    import mbs_models.scenes
+
+    files = sorted(Path(mbs_models.scenes.__file__).parent.glob("*.toml"), key=lambda p: p.stem)
+    assert main(["scenes"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert len(lines) == len(files)
+    for line, file in zip(lines, files):
+        name, description = line.split(None, 1)
+        assert name == file.stem and description == tomllib.loads(file.read_text())["name"]
+    assert main(["scenes", "--path"]) == 0
+    for line, file in zip(capsys.readouterr().out.splitlines(), files):
+        assert line.split()[0] == file.stem and f"  {file}  " in line  # a path may hold spaces
+        assert line.endswith("  " + tomllib.loads(file.read_text())["name"])

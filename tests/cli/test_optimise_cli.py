@@ -57,3 +57,43 @@ def test_bad_input_is_one_line_exit_2_and_writes_nothing(tmp_path, capsys, args,
     lines = captured.err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("recoil: error:") and text in lines[0], captured.err
     assert captured.out == "" and not out.exists()
+
+
+def test_the_summary_prints_one_unit_system_without_plot_markup(tmp_path, capsys):
+    """Every value of the summary in the SI unit typed on the command line: a constraint's limit and its value
+    in the same unit, the value the one optimum.json records; plain unit strings (no matplotlib ``$``)."""
+    out = tmp_path / "opt"
+    code = main(["optimise", "recoil_brake", "--vary", "recoil_brake.piston_area=0.008:0.016",
+                 "--vary", "recoil_brake.fluid_density=800:900", "--minimise", "peak_support_force",
+                 "--constraint", "max_barrel_displacement<=1.2", "--constraint", "peak_support_force>=100",
+                 "--out", str(out), *SMALL])
+    captured = capsys.readouterr()
+    assert code == 0, captured.err
+    assert "$" not in captured.out + captured.err
+    data = json.loads((out / "optimum.json").read_text())
+    lines = captured.out.splitlines()
+    head = lines[0].split(" = ")[1].split()
+    assert float(head[0]) == pytest.approx(data["objective"], rel=1e-5) and head[1] == "N"
+    area = next(line.split() for line in lines if "recoil_brake.piston_area" in line)
+    assert float(area[1]) == pytest.approx(data["parameters"]["recoil_brake.piston_area"], rel=1e-5)
+    assert area[2] == "m^2"
+    for constraint, (metric, op, limit, unit) in zip(data["constraints"], [
+            ("max_barrel_displacement", "<=", 1.2, "m"), ("peak_support_force", ">=", 100.0, "N")]):
+        [line] = [l for l in lines if l.strip().startswith(f"constraint {metric} {op}")]
+        words = line.split()
+        # constraint METRIC OP LIMIT UNIT value VALUE UNIT (met)
+        assert float(words[3]) == limit and words[4] == unit
+        assert words[5] == "value" and words[7] == unit
+        assert float(words[6]) == pytest.approx(constraint["value"], rel=1e-5)
+        assert (float(words[6]) <= limit if op == "<=" else float(words[6]) >= limit) and words[8] == "(met)"
+
+
+def test_a_barrel_mass_in_tonnes_warns_on_one_line(tmp_path, capsys):
+    from mbs_models import model_i, scene_to_toml
+
+    path = tmp_path / "tonnes.toml"
+    path.write_text(scene_to_toml(model_i().with_changes(**{"barrel.mass": 5.6})))
+    main(["optimise", str(path), "--vary", "contact.gap=0:0.1", "--minimise", "max_barrel_displacement",
+          "--end-time", "0.05", "--accuracy", "draft", "--out", str(tmp_path / "o"), *SMALL])
+    warned = [line for line in capsys.readouterr().err.splitlines() if "warning" in line]
+    assert len(warned) == 1 and warned[0].startswith("recoil: warning: barrel.mass = 5.6 kg")

@@ -136,3 +136,30 @@ def test_csv_has_the_time_histories_with_units(tmp_path, capsys):
     for name in ("kinetic energy [J]", "stored energy [J]", "dissipated energy [J]", "energy balance error [J]"):
         assert name in column
     assert "time histories (CSV)" in capsys.readouterr().out
+
+
+def test_a_barrel_mass_in_tonnes_warns_on_one_line_naming_the_key(tmp_path, capsys):
+    from mbs_models import simplified_model
+
+    path = tmp_path / "tonnes.toml"
+    path.write_text(scene_to_toml(simplified_model().with_changes(**{"barrel.mass": 5.6})))
+    main(["run", str(path), "--end-time", "0.05", "--accuracy", "draft"])
+    [line] = capsys.readouterr().err.strip().splitlines()
+    assert line.startswith("recoil: warning: barrel.mass = 5.6 kg gives a recoil velocity of ")
+    assert float(line.split("velocity of ")[1].split()[0]) == pytest.approx(6.86 * 564.0 / 5.6, rel=1e-3)
+
+
+def test_a_pulse_in_milliseconds_and_kilonewtons_warns_naming_its_times_and_forces(tmp_path, capsys):
+    from mbs_models.scenes import scene_path
+
+    path = tmp_path / "pulse.toml"
+    path.write_text(scene_path("breech_pulse").read_text()
+                    .replace("times  = [0.0, 0.002, 0.006, 0.012]", "times  = [0.0, 2.0, 6.0, 12.0]")
+                    .replace("forces = [0.0, 2.0e6, 6.0e5, 0.0]", "forces = [0.0, 2.0e3, 6.0e2, 0.0]")
+                    .replace("scale_to_momentum = true", "scale_to_momentum = false"))
+    assert main(["run", str(path), "--end-time", "0.5", "--accuracy", "draft"]) == 0
+    captured = capsys.readouterr()
+    times, forces = captured.err.strip().splitlines()
+    assert times.startswith("recoil: warning: firing.pulse.times span 12 s")
+    assert forces.startswith("recoil: warning: firing.pulse.forces peak at 2000 N")
+    assert "$" not in captured.out + captured.err

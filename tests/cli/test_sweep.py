@@ -134,3 +134,17 @@ def test_another_end_time_into_the_same_file_exits_2(tmp_path, capsys):
     assert main([*argv, "--end-time", "0.3"]) == 2
     err = capsys.readouterr().err
     assert "--out:" in err and "another end_time" in err and len(err.strip().splitlines()) == 1
+
+
+def test_a_sweep_over_gaps_in_millimetres_warns_once_before_it_runs(tmp_path, capsys):
+    out = tmp_path / "mm.csv"
+    assert main(["sweep", "model_ii", "--param", "contact.gap=0,40", "--out", str(out), "--end-time", "0.2",
+                 "--accuracy", "draft", "--workers", "1", "--json"]) == 0
+    captured = capsys.readouterr()
+    [line] = captured.err.strip().splitlines()
+    assert line.startswith("recoil: warning: absorber.contact.gap = 40 m is beyond")
+    assert json.loads(captured.out)["points"] == 2  # and the sweep ran every point
+    assert main(["sweep", "model_ii", "--param", "contact.gap=0,40", "--out", str(out), "--end-time", "0.2",
+                 "--accuracy", "draft", "--workers", "1"]) == 0  # resumed: the text summary
+    captured = capsys.readouterr()
+    assert "$" not in captured.out + captured.err

@@ -92,3 +92,47 @@ def test_model_labels():
     assert simplified_model().model_label == "simplified"
     assert model_i().model_label == "model (i)"
     assert model_ii().model_label == "model (ii)"
+
+
+_VERSION_1_HEADERS = {"barrel", "firing", "recoil_spring", "recoil_damper", "absorber", "contact", "conventions"}
+
+
+def _version_2_headers(text: str) -> list[str]:
+    """The table headers of a TOML text that a version-1 file cannot have, as written in it."""
+    import re
+
+    headers = re.findall(r"^\s*(\[\[?[A-Za-z_.]+\]\]?)", text, flags=re.MULTILINE)
+    return list(dict.fromkeys(h for h in headers if h.startswith("[[") or h.strip("[]") not in _VERSION_1_HEADERS))
+
+
+@pytest.mark.parametrize("name", list_scenes())
+def test_a_version_2_scene_without_its_version_key_says_so(tmp_path, name):
+    text = scene_path(name).read_text()
+    if "version = 2" not in text:
+        pytest.skip("a version-1 scene")
+    expected = _version_2_headers(text)
+    if not expected:
+        pytest.skip("uses no version-2 table (only version-2 values)")
+    path = tmp_path / f"{name}.toml"
+    path.write_text(text.replace("version = 2", ""))
+    with pytest.raises(SceneError) as info:
+        load_scene(path)
+    message = info.value.message
+    assert "has no version key" in message and message.endswith("add version = 2 at the top")
+    assert "missing required table" not in message
+    listed = message.split("(", 1)[1].split(")", 1)[0].split(", ")
+    assert listed == expected
+    path.write_text(text.replace("version = 2", "version = 1"))
+    with pytest.raises(SceneError, match="says version = 1"):
+        load_scene(path)
+
+
+def test_the_version_2_message_names_the_first_table_as_its_key():
+    data = {"name": "no version", "barrel": {"mass": 5600.0, "initial_velocity": 0.7},
+            "absorber": [{"mass": 500.0, "mount": "ground", "stiffness": 0.0, "damping": 0.0,
+                          "contact": {"gap": 0.0, "stiffness": 2.1e8, "exponent": 1.3, "damping_factor": 0.6}}],
+            "recoil_brake": {}}
+    with pytest.raises(SceneError) as info:
+        scene_from_dict(data)
+    assert info.value.key == "absorber"
+    assert "([[absorber]], [absorber.contact], [recoil_brake])" in info.value.message
