@@ -14,12 +14,17 @@ import pytest
 
 from mbs_models.scene import model_i, model_ii, simplified_model
 from validation.reference import solve_reference
+from validation.studies.guarantee import REFERENCE_IMPACT_PEAK_ACCURACY
 
 DATA = Path(__file__).resolve().parents[2] / "data" / "v1_reference_baseline.json"
 BASELINE = json.loads(DATA.read_text())
 SCALARS = ("max_barrel_displacement", "time_of_max_barrel_displacement", "peak_contact_force",
            "time_of_peak_contact_force", "max_absorber_velocity", "time_of_max_absorber_velocity")
+#: The reference's metrics at rtol 1e-10 are compared to 100x its tolerance, impact times to 1e-7 s, and each
+#: impact's peak to what the reference claims for it (a micro-bounce's peak is resolved by a few steps and
+#: moves with round-off: OpenBLAS's kernels change it by ~1e-7).  The record was made on another machine.
 RTOL, IMPACT_TIME_TOL = 1e-8, 1e-7
+IMPACT_PEAK_RTOL = REFERENCE_IMPACT_PEAK_ACCURACY
 
 
 def paper_cases() -> dict:
@@ -66,7 +71,7 @@ def test_reproduces_the_version_1_metrics(name):
         assert ours["start"] == pytest.approx(start, abs=IMPACT_TIME_TOL)
         assert ours["end"] == pytest.approx(end, abs=IMPACT_TIME_TOL)
         assert ours["time_of_peak"] == pytest.approx(time_of_peak, abs=IMPACT_TIME_TOL)
-        assert ours["peak_force"] == pytest.approx(peak, rel=RTOL)
+        assert ours["peak_force"] == pytest.approx(peak, rel=IMPACT_PEAK_RTOL)
     # version 1 listed the absorber's keys as None for the simplified model; now only connectors that exist
     dissipated = metrics["dissipated_energy"]
     assert set(dissipated) == {k for k, v in recorded["dissipated_energy"].items() if v is not None}
