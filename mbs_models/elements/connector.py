@@ -232,8 +232,9 @@ class Load:
     The base class is a constant load ``constant`` (N): Exudyn's ``LoadCoordinate`` with a fixed value, no
     user function, and exact work ``F (x(t) - x(0))``.  Subclasses with a time law set
     :attr:`needs_user_function`, implement :meth:`law` over the backend ops, and list their
-    :attr:`breakpoints` (times where F jumps: the solve is split there) and :attr:`windows` (intervals
-    where F varies: the solve's step is limited there) and :attr:`last_input_time` (F is 0 afterwards).
+    :attr:`breakpoints` (times where F jumps or its slope changes: the solve is split there, so that the
+    solver integrates a smooth F in every segment) and :attr:`windows` (intervals where F varies: the
+    solve's step is limited there) and :attr:`last_input_time` (F is 0 afterwards).
 
     Attributes
     ----------
@@ -262,9 +263,18 @@ class Load:
         t = np.asarray(t, dtype=float)
         return np.full_like(t, self.constant) if not self.needs_user_function else self.law(t, NUMPY_OPS)
 
+    def user_function_law(self, ops: Ops) -> Callable:
+        """``t -> F`` (N) over ``ops``, as the solver evaluates it: :meth:`law`.  A load whose law has pieces may
+        fix the piece per segment of the run instead (:meth:`start_segment`)."""
+        return lambda t: self.law(t, ops)
+
+    def start_segment(self, t: float) -> None:
+        """The solver is about to integrate a segment of the run from ``t`` (s) (:attr:`breakpoints` split it).
+        Nothing for a load without pieces."""
+
     @property
     def breakpoints(self) -> tuple[float, ...]:
-        """Times (s) where F jumps (the solve is split there).  A constant load has none."""
+        """Times (s) where F jumps or its slope changes (the solve is split there).  A constant load has none."""
         return ()
 
     @property
@@ -300,14 +310,13 @@ class Load:
         self.index = index
 
     def _set_user_function(self, mbs, index, user_functions: str) -> None:
-        """Record :meth:`law` as the item's load user function (if the load needs one)."""
+        """Record :meth:`user_function_law` as the item's load user function (if the load needs one)."""
         if not self.needs_user_function:
             return
-        ops = ops_for(user_functions)
-        law = self.law
+        law = self.user_function_law(ops_for(user_functions))
 
         def user_function(mbs, t, load):
-            return law(t, ops)
+            return law(t)
 
         if user_functions == "python":
             self._user_function = user_function

@@ -38,10 +38,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import ClassVar
 
+import numpy as np
+
 from ..errors import SceneError
 from .barrel import BARREL
 from .connector import Load
-from .ops import Ops, piecewise_linear
+from .ops import LinearPieces, NumpyPiecewiseLinear, Ops, piecewise_linear
 from .table import Rule, Table, check_number
 
 #: The directory that relative file names in a scene (``firing.pulse.file``) resolve against: the
@@ -254,7 +256,13 @@ class Firing(Table):
 
 
 class BreechForce(Load):
-    """The breech force ``F(t)`` on the barrel (N): piecewise linear through ``points``, 0 outside."""
+    """The breech force ``F(t)`` on the barrel (N): piecewise linear through ``points``, 0 outside.
+
+    The solve is split at every point (:attr:`breakpoints`), and in each segment the solver evaluates the
+    linear piece the segment lies in, ``F = F_i + s_i (t - t_i)`` (:meth:`user_function_law`,
+    :meth:`start_segment`): the same force inside the piece, and at the segment's end (a table point, where
+    the solver's last stage of the last step is evaluated) the piece's end value, not the next piece's.
+    """
 
     needs_user_function = True
 
@@ -262,14 +270,50 @@ class BreechForce(Load):
         super().__init__("breech_force", element, BARREL)
         self.points = list(points)
         self._windows = tuple(windows)
+        self._numpy_law = NumpyPiecewiseLinear(self.points)
+        self._pieces = LinearPieces(self.points)
+        self._piece = list(self._pieces.at(0.0))  # (t_i s, F_i N, s_i N/s) of the segment being solved
+        self._variables = None                     # the same numbers as symbolic variables, if recorded
 
     def law(self, t, ops: Ops):
         return piecewise_linear(t, self.points, ops)
 
+    def user_function_law(self, ops: Ops):
+        """``t -> F_i + s_i (t - t_i)`` (N): the piece of the segment being solved, set by :meth:`start_segment`.
+
+        Evaluated at the end of a segment that ends where F jumps (a pulse's start or end at a non-zero
+        force), :meth:`law` would give the value after the jump: the last stage of an explicit solver's last
+        step is evaluated there, and its error estimate (which uses that stage) would see the jump and shrink
+        the step until the solve stops short of the segment's end."""
+        if ops.name == "symbolic":
+            import exudyn
+            start, value, slope = self._variables = [
+                exudyn.symbolic.Real(f"{self.name}_{name}_{id(self)}", number)
+                for name, number in zip(("start", "value", "slope"), self._piece)]
+            return lambda t: value + slope * (t - start)
+        piece = self._piece
+        return lambda t: piece[1] + piece[2] * (t - piece[0])
+
+    def start_segment(self, t: float) -> None:
+        """Fix the piece of the segment that starts at ``t`` (s): the one :meth:`law` uses at ``t`` (after a jump
+        there)."""
+        self._piece[:] = self._pieces.at(t)
+        if self._variables is not None:
+            for variable, number in zip(self._variables, self._piece):
+                variable.SetValue(number)
+
+    def force(self, t):
+        """The force (N) at times ``t`` (s): :meth:`law` over numpy, the table converted once (it is
+        evaluated at the start of every segment of a run, one per table point)."""
+        return self._numpy_law(np.asarray(t, dtype=float))
+
     @property
     def breakpoints(self) -> tuple[float, ...]:
-        """Start and end of every shot's pulse (the force may jump there)."""
-        return tuple(sorted({x for window in self._windows for x in window}))
+        """Every point of every shot's table (s): the force may jump at a pulse's start and end, and its slope
+        changes at the inner points (F is only continuous there).  The solve is split at each, so that every
+        segment integrates one linear piece of F: an adaptive solver's error estimate assumes a smooth
+        right-hand side and misses a kink inside a step."""
+        return tuple(sorted({t for t, _ in self.points}))
 
     @property
     def windows(self) -> tuple[tuple[float, float], ...]:

@@ -12,6 +12,7 @@ over these ops (see :mod:`mbs_models.elements.recoil_damper` and :mod:`mbs_model
 
 from __future__ import annotations
 
+import bisect
 import math
 from dataclasses import dataclass
 from typing import Any, Callable
@@ -74,12 +75,10 @@ def piecewise_linear(x, points, ops: Ops):
     ``y = y_i + (y_{i+1} - y_i) (x - x_i) / (x_{i+1} - x_i)`` on ``[x_i, x_{i+1}]``: a chain of selections
     (one comparison per point in the symbolic backend; ``numpy.interp`` for arrays).
     """
+    if ops.name == "numpy":
+        return NumpyPiecewiseLinear(points)(x)
     xs = [float(p[0]) for p in points]
     ys = [float(p[1]) for p in points]
-    if ops.name == "numpy":
-        if all(b > a for a, b in zip(xs, xs[1:])):
-            return np.interp(x, xs, ys)
-        return _numpy_piecewise_linear(np.asarray(x, dtype=float), np.array(xs), np.array(ys))
     result = ys[-1]
     for i in range(len(xs) - 2, -1, -1):  # from the last segment back: select(x < x_{i+1}, segment_i, rest)
         if xs[i + 1] == xs[i]:
@@ -87,6 +86,53 @@ def piecewise_linear(x, points, ops: Ops):
         slope = (ys[i + 1] - ys[i]) / (xs[i + 1] - xs[i])
         result = ops.select(x < xs[i + 1], ys[i] + slope * (x - xs[i]), result)
     return ops.select(x < xs[0], ys[0], result)
+
+
+class LinearPieces:
+    """The linear pieces of :func:`piecewise_linear` through ``points``, for a solver that integrates one piece
+    at a time.
+
+    :meth:`at` gives ``(start x, value, slope)`` of the piece :func:`piecewise_linear` selects at ``x``
+    (right-continuous: at a repeated x, the piece after the jump); ``value + slope (x' - start)`` is then the
+    same float as :func:`piecewise_linear` at any ``x'`` inside that piece, and the piece's own end value at its
+    end (the left limit where the function jumps there).  Before the first point and after the last the
+    piece is the constant ``y0`` or ``y_last`` (slope 0).
+    """
+
+    def __init__(self, points):
+        xs = [float(p[0]) for p in points]
+        ys = [float(p[1]) for p in points]
+        self.ends: list[float] = []                        # piece i holds the x in [its start, ends[i])
+        self.pieces: list[tuple[float, float, float]] = []
+        for i in range(len(xs) - 1):
+            if xs[i + 1] == xs[i]:
+                continue  # a jump: no piece
+            self.ends.append(xs[i + 1])
+            self.pieces.append((xs[i], ys[i], (ys[i + 1] - ys[i]) / (xs[i + 1] - xs[i])))
+        self.first_x = xs[0]
+        self.before, self.after = (xs[0], ys[0], 0.0), (xs[-1], ys[-1], 0.0)
+
+    def at(self, x: float) -> tuple[float, float, float]:
+        """``(start x, value, slope)`` of the piece that holds ``x``."""
+        if x < self.first_x:
+            return self.before
+        i = bisect.bisect_right(self.ends, x)
+        return self.pieces[i] if i < len(self.pieces) else self.after
+
+
+class NumpyPiecewiseLinear:
+    """:func:`piecewise_linear` over numpy as a function of ``x`` alone, its table converted once (the same
+    values, bit for bit): for a table evaluated many times (a breech pulse of hundreds of points)."""
+
+    def __init__(self, points):
+        self.xs = np.array([float(p[0]) for p in points])
+        self.ys = np.array([float(p[1]) for p in points])
+        self.without_jumps = bool(np.all(self.xs[1:] > self.xs[:-1]))
+
+    def __call__(self, x):
+        if self.without_jumps:
+            return np.interp(x, self.xs, self.ys)
+        return _numpy_piecewise_linear(np.asarray(x, dtype=float), self.xs, self.ys)
 
 
 def _numpy_piecewise_linear(x: np.ndarray, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:

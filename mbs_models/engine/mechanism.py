@@ -113,7 +113,7 @@ class Mechanism:
 
     @property
     def breakpoints(self) -> list[float]:
-        """Times (s) where the solve is split: impulses and the jumps of loads, in (0, inf), sorted."""
+        """Times (s) where the solve is split: impulses and the jumps and kinks of loads, in (0, inf), sorted."""
         times = {t for t, _, _ in self.impulses}
         for load in self.loads:
             times.update(load.breakpoints)

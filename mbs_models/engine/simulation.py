@@ -340,9 +340,10 @@ STEPS_PER_LOAD_WINDOW = 40
 
 
 def segment_plan(mechanism: Mechanism, end_time: float, settings: SolverSettings) -> list[tuple[float, float, SolverSettings]]:
-    """``(start s, end s, settings)`` of each segment of a run: split at every shot and every jump of a
-    load (:attr:`Mechanism.breakpoints`); inside a load's window the adaptive ``max_step`` is at most the
-    window's length / :data:`STEPS_PER_LOAD_WINDOW`, so that no pulse is stepped over."""
+    """``(start s, end s, settings)`` of each segment of a run: split at every shot and every jump or kink of
+    a load (:attr:`Mechanism.breakpoints`: every point of a pulse's table); inside a load's window the
+    adaptive ``max_step`` is at most the window's length / :data:`STEPS_PER_LOAD_WINDOW`, so that no pulse is
+    stepped over."""
     cuts = [0.0] + [t for t in mechanism.breakpoints if t < end_time] + [float(end_time)]
     plan = []
     for t0, t1 in zip(cuts[:-1], cuts[1:]):
@@ -378,6 +379,8 @@ def _run_segments(assembly: Assembly, settings: SolverSettings, end_time: float,
                 data.SetODE2Coordinates(q.tolist(), configuration=configuration)
                 data.SetODE2Coordinates_t(v.tolist(), configuration=configuration)
         accelerations = _initial_accelerations(assembly, t0)
+        for load in mechanism.loads:  # a pulse's piece of this segment
+            load.start_segment(t0)
         n, simulated_end = _solve(assembly, segment_settings, t1, tracker, t0, run)
         steps += n
         segments.append(_read_segment(assembly, settings, t0, accelerations))

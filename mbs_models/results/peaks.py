@@ -100,12 +100,13 @@ def maxima_near_samples(time: np.ndarray, ks: np.ndarray, points: int = 65, leve
     (a :func:`~mbs_models.results.nested_grids.maxima_search` over [t_{k-1}, t_{k+1}] for every k whose
     bracket is not empty; the value at ``t_k`` itself where it is, equal times at a jump), the indices
     into ``ks`` of each search's brackets (increasing), and ``assemble(results)`` -> ``(values, times)``
-    arrays in the order of ``ks``.
+    arrays in the order of ``ks``.  A sample at a segment boundary appears twice (a largest sample is the
+    first of the two): the bracket then ends at the next later sample, ``t_{k+2}``, not at ``t_k`` again.
     """
     time = np.asarray(time, dtype=float)
     ks = np.asarray(ks, dtype=int)
     lo = time[np.maximum(ks - 1, 0)]
-    hi = time[np.minimum(ks + 1, len(time) - 1)]
+    hi = time[np.minimum(np.searchsorted(time, time[ks], side="right"), len(time) - 1)]
     open_ = hi > lo
     searches, brackets, kinds = [], [], []
     if open_.any():

@@ -15,8 +15,10 @@ import pytest
 from mbs_models import Barrel, Firing, Scene, SceneError, load_scene, scene_from_dict, scene_to_toml, simplified_model, simulate
 from mbs_models.cli import main
 from mbs_models.elements.firing import Burst, Pulse
+from mbs_models.engine.accuracy import ACCURACY_PRESETS
 from mbs_models.engine.assembly import assemble
 from mbs_models.engine.mechanism import Mechanism
+from mbs_models.engine.simulation import segment_plan
 
 PRESETS = ("draft", "standard", "reference")
 #: the pulse of DESIGN.md's example (s, N)
@@ -33,6 +35,29 @@ def pulse_mapping(**pulse) -> dict:
 
 def free_barrel(firing: Firing, burst: Burst | None = None) -> Scene:
     return Scene(barrel=Barrel(MASS), firing=firing, burst=burst, name="free barrel")
+
+
+def breech_pressure_table(points: int = 401) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """A measured-looking breech force (issue #19): the smooth rise and decay ``2 MN (t / t_p)^2 exp(2 (1 - t / t_p))``
+    (peak 2 MN at t_p = 2 ms) sampled at ``points`` unevenly spaced times over 12 ms, ``t_i = 12 ms (i / n)^1.37``
+    (n = points - 1; denser early, no point a multiple of the engine's steps).  It ends at 0.16 % of its peak: a
+    small jump to 0."""
+    times = tuple(0.012 * (i / (points - 1)) ** 1.37 for i in range(points))
+    return times, tuple(2.0e6 * (t / 0.002) ** 2 * math.exp(2.0 * (1.0 - t / 0.002)) for t in times)
+
+
+def exact_free_barrel(times, forces, t: float) -> tuple[float, float]:
+    """``(x m, v m/s)`` at ``t`` of the free barrel (mass MASS, at rest at x = 0) under the force linear between the
+    table's points and 0 outside: on ``[t_i, t_i+1]`` with slope ``s``, ``v`` gains ``(F_i h + s h^2 / 2) / M`` and
+    ``x`` gains ``v_i h + (F_i h^2 / 2 + s h^3 / 6) / M`` (exact polynomial integration)."""
+    v = x = 0.0
+    for i in range(len(times) - 1):
+        t0, t1 = times[i], times[i + 1]
+        h = min(max(t - t0, 0.0), t1 - t0)
+        slope = (forces[i + 1] - forces[i]) / (t1 - t0)
+        x += v * h + (forces[i] * h ** 2 / 2 + slope * h ** 3 / 6) / MASS
+        v += (forces[i] * h + slope * h ** 2 / 2) / MASS
+    return x + v * max(t - times[-1], 0.0), v
 
 
 # ------------------------------------------------------------------ the momentum
@@ -151,34 +176,65 @@ def test_absent_inputs_add_no_load_and_no_segment():
         assert list(assembly.loads) == ["breech_force"] and assembly.mbs.systemData.NumberOfLoads() == 1
 
 
+TABLES = {"design example": (TIMES, FORCES), "401 uneven points": breech_pressure_table(),
+          "jumps at both ends": ((0.001, 0.003, 0.007, 0.010), (5.0e5, 2.0e6, 6.0e5, 1.0e5))}
+
+
+@pytest.mark.parametrize("table", sorted(TABLES))
 @pytest.mark.parametrize("accuracy", PRESETS)
-def test_a_pulse_on_a_free_barrel_matches_the_closed_form(accuracy):
+def test_a_pulse_on_a_free_barrel_matches_the_closed_form(accuracy, table):
     """v(t) = I(t)/M with I the integral of the piecewise-linear force (exact with trapezoids of the
-    quadratic pieces); x at the end of the pulse: sum over pieces of the exact double integral."""
-    scene = free_barrel(Firing(pulse=Pulse(times=TIMES, forces=FORCES)))
+    quadratic pieces); x at the end of the pulse: sum over pieces of the exact double integral.  A table of
+    hundreds of points too: the solve is split at every point (a kink of F inside a step escapes the adaptive
+    solver's error estimate: 2.7e-8 at ``reference`` before issue #19); and a pulse that jumps at its start
+    and end (the solver evaluates each segment's own piece at its end, not the value after the jump: the
+    step collapsed there before, ``standard`` and ``reference`` stopped short of the jump)."""
+    times, forces = TABLES[table]
+    scene = free_barrel(Firing(pulse=Pulse(times=times, forces=forces)))
     result = simulate(scene, 0.05, accuracy)
-
-    def exact(t):
-        # on [t_i, t_i+1]: F = F_i + s (t - t_i); v and x by exact polynomial integration
-        v = x = 0.0
-        for i in range(len(TIMES) - 1):
-            t0, t1 = TIMES[i], TIMES[i + 1]
-            h = min(max(t - t0, 0.0), t1 - t0)
-            slope = (FORCES[i + 1] - FORCES[i]) / (t1 - t0)
-            x += v * h + (FORCES[i] * h ** 2 / 2 + slope * h ** 3 / 6) / MASS
-            v += (FORCES[i] * h + slope * h ** 2 / 2) / MASS
-        return x + v * max(t - TIMES[-1], 0.0), v
-
     tolerance = {"draft": 1e-4, "standard": 1e-6, "reference": 1e-9}[accuracy]
-    x_end, v_end = exact(0.05)
+    x_end, v_end = exact_free_barrel(times, forces, 0.05)
     assert result.barrel_velocity[-1] == pytest.approx(v_end, rel=tolerance)
     assert result.barrel_position[-1] == pytest.approx(x_end, rel=tolerance)
     for t in (0.001, 0.004, 0.009):
         k = int(np.argmin(np.abs(result.time - t)))
-        x, v = exact(result.time[k])
+        x, v = exact_free_barrel(times, forces, result.time[k])
         assert result.barrel_velocity[k] == pytest.approx(v, rel=tolerance, abs=tolerance * v_end)
     # the work of the breech force is the kinetic energy it gave
     assert result.energy()["firing"]["work"] == pytest.approx(0.5 * MASS * v_end ** 2, rel=10 * tolerance)
+
+
+def test_python_and_symbolic_user_functions_give_the_same_pulse():
+    """The per-segment piece of the breech force (:meth:`BreechForce.user_function_law`) in both backends."""
+    times, forces = TABLES["jumps at both ends"]
+    scene = scene_from_dict(pulse_mapping()).with_changes(
+        firing=Firing(projectile_mass=6.86, muzzle_velocity=564.0, pulse=Pulse(times=times, forces=forces)))
+    symbolic = simulate(scene, 1.0, user_functions="symbolic")
+    python = simulate(scene, 1.0, user_functions="python")
+    assert len(python.time) == len(symbolic.time)
+    np.testing.assert_allclose(python.barrel_position, symbolic.barrel_position, rtol=1e-12, atol=1e-15)
+    assert python.energy()["firing"]["work"] == pytest.approx(symbolic.energy()["firing"]["work"], rel=1e-12)
+
+
+def test_the_solve_is_split_at_every_point_of_the_table():
+    """Every point of every shot's table (shifted by the shot time) inside (0, end) is a segment boundary, so every
+    segment sees one linear piece of F; inside a pulse the step is at most a 40th of it, outside it is the preset's."""
+    times, forces = breech_pressure_table()
+    firing = Firing(projectile_mass=6.86, muzzle_velocity=564.0,
+                    pulse=Pulse(times=times, forces=forces, scale_to_momentum=True))
+    mechanism = Mechanism(simplified_model().with_changes(firing=firing, burst=Burst(shots=2, interval=0.5)))
+    standard = ACCURACY_PRESETS["standard"]
+    points = sorted({shot + t for shot in (0.0, 0.5) for t in times} - {0.0})
+    assert len(points) == 2 * 401 - 1
+    plan = segment_plan(mechanism, 1.0, standard)
+    assert [t0 for t0, _, _ in plan] == [0.0] + points
+    assert [t1 for _, t1, _ in plan] == points + [1.0]
+    for t0, t1, settings in plan:
+        in_pulse = any(shot <= t0 < shot + times[-1] for shot in (0.0, 0.5))
+        assert settings.max_step == pytest.approx(0.012 / 40 if in_pulse else standard.max_step, rel=1e-12), (t0, t1)
+    # a run that ends inside the pulse: the points before its end, then the end
+    inside = [t for t in points if t < 0.005]
+    assert [(t0, t1) for t0, t1, _ in segment_plan(mechanism, 0.005, standard)] == list(zip([0.0] + inside, inside + [0.005]))
 
 
 @pytest.mark.parametrize("accuracy", PRESETS)
@@ -296,8 +352,19 @@ def _ten_shots() -> Scene:
     return model_ii(1000.0, 0.0).with_changes(burst=Burst(shots=10, interval=0.3), name="model (ii), 10 shots")
 
 
+def _many_point_pulse_on_model_ii() -> Scene:
+    """Issue #19: model (ii) at gap 0 driven by the 401-point breech pressure table, scaled to the paper's momentum
+    (before the solve was split at every table point: an energy error of 1.1e-7 at ``reference``, tolerance 5e-9)."""
+    from mbs_models import model_ii
+    times, forces = breech_pressure_table()
+    firing = Firing(projectile_mass=6.86, muzzle_velocity=564.0,
+                    pulse=Pulse(times=times, forces=forces, scale_to_momentum=True))
+    return model_ii(1000.0, 0.0).with_changes(firing=firing, name="model (ii), 401-point pulse")
+
+
 CASES = {"breech_pulse": lambda: _shipped("breech_pulse"), "burst": lambda: _shipped("burst"),
-         "short_pulse": _short_pulse_on_model_ii, "ten_shots": _ten_shots}
+         "short_pulse": _short_pulse_on_model_ii, "ten_shots": _ten_shots,
+         "many_point_pulse": _many_point_pulse_on_model_ii}
 
 
 @pytest.mark.parametrize("accuracy", PRESETS)

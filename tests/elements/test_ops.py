@@ -4,7 +4,7 @@ import exudyn
 import numpy as np
 import pytest
 
-from mbs_models.elements.ops import NUMPY_OPS, PYTHON_OPS, piecewise_linear, symbolic_ops
+from mbs_models.elements.ops import NUMPY_OPS, PYTHON_OPS, LinearPieces, piecewise_linear, symbolic_ops
 
 PULSE = [(0.0, 0.0), (0.002, 2.0e6), (0.006, 6.0e5), (0.012, 0.0)]
 
@@ -45,3 +45,20 @@ def test_piecewise_linear_with_a_jump_is_right_continuous_on_every_backend():
         assert piecewise_linear(x, points, PYTHON_OPS) == pytest.approx(expected, abs=1e-12)
         assert piecewise_linear(np.array([x]), points, NUMPY_OPS)[0] == pytest.approx(expected, abs=1e-12)
         assert _symbolic(lambda v, ops: piecewise_linear(v, points, ops), x) == pytest.approx(expected, abs=1e-12)
+
+
+def test_linear_pieces_are_the_pieces_of_piecewise_linear():
+    """A solver integrating the piece that holds a segment's start (:class:`LinearPieces`) gets the function's
+    value inside the piece and, at the piece's end, its left limit: 3 at x = 1 where the function jumps to 0."""
+    points = [(0.0, 0.0), (0.0, 5.0), (1.0, 3.0), (1.0, 0.0)]  # 5 - 2 x on [0, 1), 0 elsewhere
+    pieces = LinearPieces(points)
+    assert pieces.at(-0.5) == (0.0, 0.0, 0.0) and pieces.at(1.0) == (1.0, 0.0, 0.0) and pieces.at(3.0) == (1.0, 0.0, 0.0)
+    assert pieces.at(0.0) == pieces.at(0.7) == (0.0, 5.0, -2.0)
+    start, value, slope = pieces.at(0.25)
+    assert value + slope * (1.0 - start) == 3.0  # the left limit at the jump
+    for x in np.linspace(-0.5, 1.5, 41):  # inside every piece: the same float as the function
+        start, value, slope = pieces.at(float(x))
+        assert value + slope * (float(x) - start) == piecewise_linear(float(x), points, PYTHON_OPS), x
+    for x in np.linspace(0.0, 0.012, 25):
+        start, value, slope = LinearPieces(PULSE).at(float(x))
+        assert value + slope * (float(x) - start) == piecewise_linear(float(x), PULSE, PYTHON_OPS), x

@@ -7,9 +7,11 @@ structures and numbers have run, and is compared with ``simulate(scene, ...)`` (
 
 from __future__ import annotations
 
+import math
+
 import pytest
 
-from mbs_models import Simulator, load_scene, model_i, model_ii, simplified_model, simulate
+from mbs_models import Firing, Pulse, Simulator, load_scene, model_i, model_ii, simplified_model, simulate
 from mbs_models.engine.assembly import assemble, refill, structure_key
 from mbs_models.engine.mechanism import Mechanism
 from mbs_models.scenes import list_scenes, scene_path
@@ -79,6 +81,28 @@ def test_shipped_scenes_are_bit_identical_after_other_points(assert_results_iden
             fresh = simulate(scene, 1.5, "draft")
             assert_results_identical(reused, fresh)
         assert simulator.reuses >= len(scenes)  # every scene at least reused its variant's system
+
+
+def _pulse_scene(points: int, peak_time: float):
+    """The simplified model under a breech pulse of ``points`` unevenly spaced table points (a triangle-like rise to
+    ``peak_time`` s and decay over 12 ms, scaled to the paper's momentum): a segment per table point."""
+    times = [0.012 * (i / (points - 1)) ** 1.3 for i in range(points)]
+    forces = [t / peak_time if t < peak_time else math.exp(-(t - peak_time) / 0.003) for t in times]
+    firing = Firing(projectile_mass=6.86, muzzle_velocity=564.0,
+                    pulse=Pulse(times=times, forces=forces, scale_to_momentum=True))
+    return simplified_model().with_changes(firing=firing, name=f"{points}-point pulse")
+
+
+def test_pulses_of_hundreds_of_points_are_bit_identical(assert_results_identical):
+    """A 401-point pulse (401 segments) after a 41-point one and another 401-point shape, through one Simulator;
+    with and without the early stop."""
+    with Simulator() as simulator:
+        for scene in (_pulse_scene(41, 0.002), _pulse_scene(401, 0.003), _pulse_scene(401, 0.002)):
+            for accuracy in ("draft", "reference"):
+                assert_results_identical(simulator.simulate(scene, 1.0, accuracy), simulate(scene, 1.0, accuracy))
+            assert_results_identical(simulator.simulate(scene, 2.0, "standard", stop_when_final=EARLY),
+                                     simulate(scene, 2.0, "standard", stop_when_final=EARLY))
+        assert simulator.assemblies == 1
 
 
 def test_refill_refuses_another_structure_and_the_cache_falls_back_to_a_fresh_build(assert_results_identical):

@@ -34,6 +34,18 @@ def test_refine_function_maximum_of_a_narrow_pulse():
     assert time == pytest.approx(0.0075, abs=1e-8)
 
 
+def test_a_maximum_just_after_a_segment_boundary_is_found():
+    """A segmented run repeats the sample at each segment boundary (here t = 0.3 s); the largest sample is the
+    first of the two, and the maximum of f = 1 - (t - 0.34)^2 lies in the interval after the boundary."""
+    t = np.array([0.0, 0.1, 0.2, 0.3, 0.3, 0.4, 0.5])
+    f = lambda x: 1.0 - (x - 0.34) ** 2  # noqa: E731
+    k = int(np.argmax(f(t)))
+    assert k == 3  # the first copy: f(0.3) = 0.9984 > f(0.4) = 0.9964
+    value, time = refine_function_maximum(f, t, k)
+    assert time == pytest.approx(0.34, abs=1e-8)
+    assert value == pytest.approx(1.0, abs=1e-12)
+
+
 def test_refine_crossing_finds_switch_time():
     switch = 0.123456789
     found = refine_crossing(lambda x: x >= switch, 0.1, 0.2)
