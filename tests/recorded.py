@@ -157,7 +157,7 @@ def differences(new, recorded, kind_of, accuracy: str, run_scales: dict, path: s
     the kind of the number at a path (``"exact"`` for counts, flags and names).  Keys added to the outputs
     since the recording are not compared; every recorded key must be there.  A recorded :func:`summary`
     (a dict with ``"size"``) is compared with the summary of the new array."""
-    if _is_summary(recorded):
+    if is_summary(recorded):
         if not isinstance(new, dict) or "size" not in new:
             return [f"{path}: recorded a history, got {type(new).__name__}"]
         if new["size"] != recorded["size"]:
@@ -189,7 +189,8 @@ def differences(new, recorded, kind_of, accuracy: str, run_scales: dict, path: s
     return []
 
 
-def _is_summary(value) -> bool:
+def is_summary(value) -> bool:
+    """True for a recorded :func:`summary` of a history."""
     return isinstance(value, dict) and "size" in value and set(value) <= {"size", "samples", "max", "min", "mean",
                                                                           "mean_abs"}
 

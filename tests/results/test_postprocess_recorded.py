@@ -34,6 +34,16 @@ BASELINE = RECORD["runs"]
 
 pytestmark = pytest.mark.recorded
 
+#: Shipped scenes whose file changed since the recording: the run uses the file as it was then.
+SCENES_AS_RECORDED = {"realistic": ROOT / "tests" / "data" / "scenes_as_recorded" / "realistic.toml"}
+#: Shipped scenes whose solve changed by design since the recording, and why: their step sequence differs, so
+#: their step counts and histories (sampled by index) are not compared; every post-processed metric still is.
+SOLVE_CHANGED = {
+    "breech_pulse": "issue #19: the solve is split at every point of the pulse's table (the presets' accuracy "
+                    "with tables whose points fall between steps)",
+    "realistic": "issue #19: its pulse, as breech_pulse",
+}
+
 
 def scene_of(key: str):
     """``(scene, end_time, accuracy, impact_threshold)`` of a recorded run's key."""
@@ -47,7 +57,20 @@ def scene_of(key: str):
     if kind == "hard":
         case = HARD_CASES_BY_NAME[name]
         return case.scene, case.end_time, accuracy, 1000.0
-    return load_scene(scene_path(name)), 10.0, accuracy, float(rest[0])
+    return load_scene(SCENES_AS_RECORDED.get(name) or scene_path(name)), 10.0, accuracy, float(rest[0])
+
+
+def metrics_only(run: dict) -> dict:
+    """A run's record without its step count, histories and the largest samples of its histories (its scales:
+    the tolerances still use the recorded ones) (:data:`SOLVE_CHANGED`)."""
+    def keep(value):
+        if isinstance(value, dict):
+            return {k: keep(v) for k, v in value.items()
+                    if k not in ("steps", "scales") and not recorded.is_summary(v)}
+        if isinstance(value, list):
+            return [keep(v) for v in value]
+        return value
+    return keep(run)
 
 
 def _marks(key: str):
@@ -61,8 +84,19 @@ def test_matches_the_recorded_outputs(key):
     scene, end_time, accuracy, threshold = scene_of(key)
     record = BASELINE[key]
     new = _recorder.record(simulate(scene, end_time, accuracy, impact_threshold=threshold), accuracy)
+    if key.split("/")[0] == "scene" and key.split("/")[1] in SOLVE_CHANGED:
+        new, record = metrics_only(new), metrics_only(record)
     problems = recorded.differences(new, record, recorded.kind_of_output, accuracy, record["scales"])
     assert not problems, problems[:10]
+
+
+def test_what_changed_since_the_recording_is_named():
+    """The exceptions above name recorded scenes, and still compare most of their record."""
+    shipped = {key.split("/")[1] for key in BASELINE if key.startswith("scene/")}
+    assert set(SOLVE_CHANGED) <= shipped and set(SCENES_AS_RECORDED) <= shipped
+    assert all(path.is_file() for path in SCENES_AS_RECORDED.values())
+    kept = metrics_only(BASELINE["scene/realistic/standard/1000"])
+    assert "steps" not in kept["metrics"] and "support_force" not in kept and kept["metrics"]["shots"]
 
 
 def test_the_record_covers_what_the_issue_names():
