@@ -84,9 +84,10 @@ def test_matches_the_recorded_outputs(key):
     scene, end_time, accuracy, threshold = scene_of(key)
     record = BASELINE[key]
     new = _recorder.record(simulate(scene, end_time, accuracy, impact_threshold=threshold), accuracy)
+    scales = record["scales"]
     if key.split("/")[0] == "scene" and key.split("/")[1] in SOLVE_CHANGED:
         new, record = metrics_only(new), metrics_only(record)
-    problems = recorded.differences(new, record, recorded.kind_of_output, accuracy, record["scales"])
+    problems = recorded.differences(new, record, recorded.kind_of_output, accuracy, scales)
     assert not problems, problems[:10]
 
 
