@@ -57,8 +57,8 @@ class Peak:
         return "on counter-recoil into the buffer" if self.into_buffer else "on counter-recoil"
 
     def text(self) -> str:
-        """``peak brake force 85.1 kN during recoil (t = 0.012 s)``."""
-        return f"peak {self.label} {self.force / 1e3:.1f} kN {self.where} (t = {self.time:.3f} s)"
+        """``peak brake force 85.12 kN during recoil (t = 0.012 s)``."""
+        return f"peak {self.label} {self.force / 1e3:.2f} kN {self.where} (t = {self.time:.3f} s)"
 
     def to_dict(self) -> dict:
         return {"force": self.force, "time": self.time, "phase": self.phase, "into_buffer": self.into_buffer}

@@ -107,7 +107,7 @@ def test_the_text_names_the_asked_and_achieved_length_and_each_peak_s_phase(tmp_
         assert set(peaks) == {"brake", "battery_stop", "mount"}  # the base has a battery buffer
         for name, peak in peaks.items():
             label = damper if name == "brake" else labels[name]
-            text = (f"    peak {label} {peak['force'] / 1e3:.1f} kN {where[peak['phase'], peak['into_buffer']]} "
+            text = (f"    peak {label} {peak['force'] / 1e3:.2f} kN {where[peak['phase'], peak['into_buffer']]} "
                     f"(t = {peak['time']:.3f} s)")
             assert text in lines, text
     # the linear damper's weak counter-recoil damping: its barrel meets the buffer at speed, the mount's peak

@@ -58,9 +58,9 @@ def test_a_barrel_slamming_into_its_buffer_peaks_on_counter_recoil():
         assert peaks[name].text().split(" (t =")[0].endswith("on counter-recoil into the buffer")
     assert peaks["mount"].force == pytest.approx(slam, rel=0.02)
     brake = peaks["brake"]  # K v0^2 at the shot
-    assert brake.phase == RECOIL and brake.time == 0.0 and brake.text().startswith("peak brake force 8.1 kN during "
-                                                                                    "recoil (t = 0.000 s)")
-    assert brake.force == pytest.approx(_coefficient(3e-4) * V0 ** 2, rel=1e-9)
+    at_shot = _coefficient(3e-4) * V0 ** 2
+    assert brake.phase == RECOIL and brake.time == 0.0 and brake.force == pytest.approx(at_shot, rel=1e-9)
+    assert brake.text() == f"peak brake force {at_shot / 1e3:.2f} kN during recoil (t = 0.000 s)"
 
 
 def test_a_hard_brake_peaks_at_the_shot_during_recoil():
@@ -70,7 +70,7 @@ def test_a_hard_brake_peaks_at_the_shot_during_recoil():
     assert V0 * math.sqrt(1e6 * M) < 0.75 * at_shot  # the phases' margin
     assert peaks["mount"].phase == RECOIL and not peaks["mount"].into_buffer
     assert peaks["mount"].force == pytest.approx(at_shot, rel=1e-6) and peaks["mount"].time == pytest.approx(0.0, abs=1e-9)
-    assert peaks["mount"].text().split(" (t =")[0] == f"peak force on the mount {at_shot / 1e3:.1f} kN during recoil"
+    assert peaks["mount"].text().split(" (t =")[0] == f"peak force on the mount {at_shot / 1e3:.2f} kN during recoil"
     if "battery_stop" in peaks:  # touched on the return: by then it is the counter-recoil
         assert peaks["battery_stop"].phase == COUNTER_RECOIL and peaks["battery_stop"].force < V0 * math.sqrt(1e6 * M)
 
