@@ -139,10 +139,12 @@ def hit_recoil_length(scene: Scene, recoil_length: float, tolerance: float | Non
                 longest.append(longest_design_length(scene, design_length, points, fraction))
             limit = longest[0]
             if limit is not None and step >= limit:
-                if design_length >= limit:
+                if design_length >= limit:  # the longest design is short of L: no design reaches it
+                    reason = _limit_reason(scene, limit, points, fraction)
                     raise SceneError("recoil_length", f"{asked:g} m is too long: the longest recoil a constant-"
-                                                      f"resistance brake gives on this scene is {result.max_barrel_displacement:.6g} m "
-                                                      f"(designed for {limit:.6g} m; {_limit_reason(scene, limit, points, fraction)})")
+                                                      f"resistance brake gives on this scene is "
+                                                      f"{result.max_barrel_displacement:.6g} m (designed for "
+                                                      f"{limit:.6g} m; {reason})")
                 step = limit
         design_length = step
     best = min(iterations, key=lambda pair: abs(pair[1] - asked))

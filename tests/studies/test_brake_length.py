@@ -17,7 +17,7 @@ import re
 import numpy as np
 import pytest
 
-from mbs_models import SceneError, SimulationError, load_scene, simplified_model
+from mbs_models import SceneError, SimulationError, load_scene, scene_to_toml, simplified_model
 from mbs_models.cli import main
 from mbs_models.studies import brake_length
 from mbs_models.studies.brake_design import design_brake
@@ -69,7 +69,6 @@ def test_a_long_recoil_is_hit_where_the_scene_allows_it(tmp_path):
     """1.0 m needs a soft spring: with k = 1000 N/m the spring alone stops the barrel at
     v0 sqrt(M / k) = 1.63 m; the recoil takes ~3 s (2 L / v0 = 2.9 s at constant deceleration), so 8 s."""
     soft = tmp_path / "soft.toml"
-    from mbs_models import scene_to_toml
     soft.write_text(scene_to_toml(simplified_model().with_changes(**{"recoil_spring.stiffness": 1000.0})))
     out = tmp_path / "design"
     assert main(["design-brake", str(soft), "--recoil-length", "1.0", "--end-time", "8", "--out", str(out)]) == 0
@@ -122,7 +121,6 @@ def test_a_barrel_that_never_turns_is_refused(tmp_path, capsys):
     """Without a spring nothing returns the barrel: the brake's K v^2 only slows it (v = v1 / (1 + K v1 t / M)
     never reaches 0), so no recoil length exists in any window."""
     free = tmp_path / "free.toml"
-    from mbs_models import scene_to_toml
     free.write_text(scene_to_toml(simplified_model().with_changes(recoil_spring=None)))
     assert main(["design-brake", str(free), "--recoil-length", "0.2", "--out", str(tmp_path / "x")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
