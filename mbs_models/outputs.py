@@ -30,6 +30,25 @@ def prepare_output_dir(path: str | Path, key: str = "--out") -> Path:
     return path
 
 
+def check_output_dir(path: str | Path, key: str = "--out") -> Path:
+    """Check, creating nothing, that :func:`prepare_output_dir` can make ``path`` a writable directory:
+    an existing directory must be writable, else its nearest existing ancestor must be a writable
+    directory; SceneError naming ``key`` if not."""
+    path = Path(path)
+    if path.exists():
+        if not path.is_dir():
+            raise SceneError(key, f"{path} exists and is not a directory")
+        if not os.access(path, os.W_OK | os.X_OK):
+            raise SceneError(key, f"output directory {path} is not writable")
+        return path
+    ancestor = path.absolute().parent
+    while not ancestor.exists():
+        ancestor = ancestor.parent
+    if not ancestor.is_dir() or not os.access(ancestor, os.W_OK | os.X_OK):
+        raise SceneError(key, f"cannot create output directory {path}: {ancestor} is not a writable directory")
+    return path
+
+
 def current_umask() -> int:
     """The process's umask, read without changing it where Linux reports it (``/proc/self/status``);
     elsewhere set and restored at once."""

@@ -45,3 +45,16 @@ def test_rewrite_is_atomic_and_leaves_no_temporary(tmp_path, umask):
     atomic_write_text(path, "second")
     assert path.read_text() == "second"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out.txt"]
+
+
+def test_an_output_directory_is_checked_without_being_created(tmp_path):
+    from mbs_models import SceneError
+    from mbs_models.outputs import check_output_dir
+
+    assert check_output_dir(tmp_path / "a" / "b") == tmp_path / "a" / "b"
+    assert not (tmp_path / "a").exists()  # nothing created
+    (tmp_path / "file").write_text("x")
+    with pytest.raises(SceneError, match="exists and is not a directory"):
+        check_output_dir(tmp_path / "file", "--out")
+    with pytest.raises(SceneError, match="is not a writable directory"):
+        check_output_dir(tmp_path / "file" / "below", "--out")  # its nearest existing ancestor is a file

@@ -157,23 +157,27 @@ def _cmd_contact_laws(args) -> int:
 
 
 def _cmd_design_brake(args) -> int:
-    from ..outputs import atomic_write_json, atomic_write_text, prepare_output_dir
+    from ..outputs import atomic_write_json, atomic_write_text, check_output_dir, prepare_output_dir
     from ..results.plotting import save_figure
     from ..scene.io import scene_to_toml
-    from ..studies.brake_design import compare_with_linear_damper, design_brake, plot_comparison
+    from ..studies.brake_design import compare_with_linear_damper, plot_comparison
+    from ..studies.recoil_peaks import peak_forces
 
     scene = _resolve_scene(args.scene)
     if args.recoil_length is None or not args.recoil_length > 0:
         raise SceneError("--recoil-length", f"must be a length > 0 m, got {args.recoil_length!r}")
-    try:
-        design_brake(scene, args.recoil_length)  # a bad design: exit 2 before anything is written
-    except SceneError as exc:
-        if exc.key == "recoil_length":
-            raise SceneError("--recoil-length", exc.message) from None
-        raise
-    out = prepare_output_dir(args.out)  # bad --out: exit 2 before any work
+    if not 0.0 < args.end_time <= 1e4:
+        raise SceneError("--end-time", f"must be a number of seconds in (0, 10000], got {args.end_time!r}")
+    check_output_dir(args.out)  # bad --out: exit 2 before any work
     start = time.perf_counter()
-    comparison = compare_with_linear_damper(scene, args.recoil_length, args.accuracy)
+    try:  # a length it cannot design: exit 2 (exit 1 if it does not converge), nothing written
+        comparison = compare_with_linear_damper(scene, args.recoil_length, args.accuracy, args.end_time,
+                                                tolerance=args.tolerance)
+    except SceneError as exc:
+        if exc.key in ("recoil_length", "tolerance"):
+            raise SceneError(f"--{exc.key.replace('_', '-')}", exc.message) from None
+        raise
+    out = prepare_output_dir(args.out)
     atomic_write_text(out / "designed.toml", scene_to_toml(comparison.design.scene))
     save_figure(plot_comparison(comparison), out / "design_brake.png")
     data = comparison.to_dict()
@@ -181,13 +185,19 @@ def _cmd_design_brake(args) -> int:
     if args.json:
         print(json.dumps(data, indent=2, allow_nan=False))
     else:
-        d, lin = data["designed"], data["linear_damper"]
-        print(f"constant resistance R = {data['constant_resistance'] / 1e3:.3f} kN over {args.recoil_length:g} m "
+        length, lin = comparison.length, data["linear_damper"]
+        runs = len(length.iterations)
+        print(f"recoil length {length.recoil_length:.5f} m for {length.asked:g} m asked (tolerance "
+              f"{1e3 * length.tolerance:.3g} mm; {runs} simulation{'s' if runs > 1 else ''}: the table is the "
+              f"constant-resistance design for {length.design_length:.5g} m)")
+        print(f"constant resistance R = {data['constant_resistance'] / 1e3:.3f} kN "
               f"(flat to {100 * data['resistance_flatness_over_90_percent']:.2f} % over 90 % of the stroke)")
-        print(f"  designed brake   recoil length {d['recoil_length']:.4f} m, peak support force "
-              f"{d['peak_support_force'] / 1e3:.3f} kN")
-        print(f"  linear damper    recoil length {lin['recoil_length']:.4f} m, peak support force "
-              f"{lin['peak_support_force'] / 1e3:.3f} kN (c = {lin['recoil']:.0f} / {lin['counter_recoil']:.0f} N s/m)")
+        for title, result in (("designed brake", comparison.designed), ("linear damper", comparison.linear)):
+            print(f"  {title}: recoil length {result.max_barrel_displacement:.5f} m"
+                  + ("" if result is comparison.designed else
+                     f", c = {lin['recoil']:.0f} / {lin['counter_recoil']:.0f} N s/m"))
+            for peak in peak_forces(result).values():
+                print(f"    {peak.text()}")
         print(f"wrote designed.toml, design_brake.png, design_brake.json to {out} in "
               f"{time.perf_counter() - start:.1f} s")
     return EXIT_OK
@@ -252,6 +262,11 @@ def build_parser() -> argparse.ArgumentParser:
     design.add_argument("scene", help="scene TOML file or shipped scene (a barrel without absorbers, e.g. simplified)")
     design.add_argument("--recoil-length", type=float, required=True, metavar="L", help="recoil length in m")
     design.add_argument("--out", default="design-brake", help="output directory (default ./design-brake)")
+    design.add_argument("--tolerance", type=float, default=None, metavar="TOL",
+                        help="how close (m) the simulated recoil length must come to L: the design length is "
+                             "iterated on the simulation until it does (default: 0.1 %% of L, at least 0.1 mm)")
+    design.add_argument("--end-time", type=float, default=3.0,
+                        help="simulated time in s of every run (default 3): the barrel must turn and return")
     design.add_argument("--accuracy", default="standard", choices=("draft", "standard", "reference"),
                         help=ACCURACY_HELP)
     design.add_argument("--json", action="store_true", help="print the comparison as JSON")

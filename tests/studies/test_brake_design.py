@@ -84,3 +84,34 @@ def test_recoil_design_brake_writes_a_ready_scene_the_figure_and_json(tmp_path, 
     assert data["resistance_flatness_over_90_percent"] < 0.02
     scene = load_scene(out / "designed.toml")  # a ready scene
     assert scene.recoil_brake.orifice_area[0][1] == pytest.approx(data["orifice_areas"][0])
+
+
+def test_the_text_names_the_asked_and_achieved_length_and_each_peak_s_phase(tmp_path, capsys):
+    """The realistic base at 0.3 m: the summary states the asked and simulated lengths, the tolerance and the
+    simulations run, and every peak with its phase and time, as the JSON has them."""
+    import re
+
+    out = tmp_path / "design"
+    assert main(["design-brake", "scripts/realistic_base.toml", "--recoil-length", "0.3", "--out", str(out)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    data = json.loads((out / "design_brake.json").read_text())
+    first = re.fullmatch(r"recoil length ([\d.]+) m for 0.3 m asked \(tolerance 0.3 mm; (\d+) simulations?: the table "
+                         r"is the constant-resistance design for ([\d.]+) m\)", lines[0])
+    assert first and float(first.group(1)) == pytest.approx(data["recoil_length_achieved"], abs=1e-5)
+    assert int(first.group(2)) == len(data["iterations"])
+    labels = {"brake": "brake force", "battery_stop": "battery-stop force", "mount": "force on the mount"}
+    where = {("recoil", False): "during recoil", ("counter-recoil", False): "on counter-recoil",
+             ("counter-recoil", True): "on counter-recoil into the buffer"}
+    for case, damper in (("designed", "brake force"), ("linear_damper", "damper force")):
+        peaks = data[case]["peaks"]
+        assert set(peaks) == {"brake", "battery_stop", "mount"}  # the base has a battery buffer
+        for name, peak in peaks.items():
+            label = damper if name == "brake" else labels[name]
+            text = (f"    peak {label} {peak['force'] / 1e3:.2f} kN {where[peak['phase'], peak['into_buffer']]} "
+                    f"(t = {peak['time']:.3f} s)")
+            assert text in lines, text
+    # the linear damper's weak counter-recoil damping: its barrel meets the buffer at speed, the mount's peak
+    # is more than twice the largest support force up to the turning point, so it must be the return's
+    linear = data["linear_damper"]
+    assert linear["peak_support_force_in_recoil"] < 0.5 * linear["peak_support_force"]
+    assert linear["peaks"]["mount"]["phase"] == "counter-recoil" and linear["peaks"]["mount"]["into_buffer"]
