@@ -9,9 +9,10 @@ paper's simplified model, +10 % at 0.05 m and -0.02 % at 0.2215 m.
 
 :func:`hit_recoil_length` solves ``f(L_d) = L`` for the asked ``L`` to ``|f(L_d) - L| <= tolerance``,
 each ``f`` a full simulation of the designed scene at the asked accuracy.  ``f`` grows with ``L_d`` (a
-longer design has a smaller R and a larger orifice at every stroke), so the iteration is a safeguarded
-secant: a proportional step ``L_d <- L_d L / f(L_d)`` until the root is bracketed, then secant steps kept
-inside the bracket (bisection when one would leave it), at most ``max_iterations`` simulations.
+longer design has a smaller R and a larger orifice at every stroke): proportional steps
+``L_d <- L_d L / f(L_d)`` until the root is bracketed, then Brent's method inside the bracket
+(``scipy.optimize.brentq``), stopped by the first run within tolerance; at most ``max_iterations``
+simulations.
 
 Refusals (:class:`~mbs_models.errors.SceneError`, key ``recoil_length``, nothing designed): ``L`` longer
 than the recoil of the longest design the rule accepts (:func:`~mbs_models.studies.brake_design.
@@ -25,6 +26,8 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+
+from scipy.optimize import brentq
 
 from ..errors import SceneError, SimulationError
 from ..scene import Scene
@@ -86,6 +89,18 @@ class LengthDesign:
                 "iterations": [{"design_length": d, "recoil_length": x} for d, x in self.iterations]}
 
 
+class _Hit(Exception):
+    """A run within tolerance: ends the iteration with its design and result."""
+
+    def __init__(self, design, result):
+        super().__init__()
+        self.design, self.result = design, result
+
+
+class _OutOfRuns(Exception):
+    """``max_iterations`` simulations run without one within tolerance."""
+
+
 def hit_recoil_length(scene: Scene, recoil_length: float, tolerance: float | None = None,
                       accuracy: str = "standard", end_time: float = 3.0, points: int = 41, fraction: float = 0.95,
                       max_iterations: int | None = None) -> LengthDesign:
@@ -121,32 +136,47 @@ def hit_recoil_length(scene: Scene, recoil_length: float, tolerance: float | Non
         iterations.append((float(design_length), result.max_barrel_displacement))
         return design, result
 
-    low = high = None  # (L_d, f - L) with f - L < 0 and > 0: the bracket once both are known
-    previous = None
-    for _ in range(max_iterations):
-        design, result = run(design_length)
-        residual = result.max_barrel_displacement - asked
-        if abs(residual) <= tolerance:
-            return LengthDesign(design, result, asked, tolerance, iterations)
-        if residual < 0:
-            low = (design_length, residual)
-        else:
-            high = (design_length, residual)
-        step = _next_length(design_length, residual, asked, previous, low, high)
-        previous = (design_length, residual)
-        if residual < 0 and high is None:  # longer: stay within the lengths the rule designs
-            if not longest:
-                longest.append(longest_design_length(scene, design_length, points, fraction))
-            limit = longest[0]
-            if limit is not None and step >= limit:
-                if design_length >= limit:  # the longest design is short of L: no design reaches it
-                    reason = _limit_reason(scene, limit, points, fraction)
-                    raise SceneError("recoil_length", f"{asked:g} m is too long: the longest recoil a constant-"
-                                                      f"resistance brake gives on this scene is "
-                                                      f"{result.max_barrel_displacement:.6g} m (designed for "
-                                                      f"{limit:.6g} m; {reason})")
-                step = limit
-        design_length = step
+    runs: dict[float, tuple] = {}  # L_d -> (design, result, f - L): brentq asks again for the bracket's ends
+
+    def residual(design_length: float) -> float:
+        if design_length not in runs:
+            if len(iterations) >= max_iterations:
+                raise _OutOfRuns
+            design, result = run(design_length)
+            runs[design_length] = (design, result, result.max_barrel_displacement - asked)
+            if abs(runs[design_length][2]) <= tolerance:
+                raise _Hit(design, result)
+        return runs[design_length][2]
+
+    try:
+        low = high = None  # L_d with f - L < 0 and > 0: the bracket once both are known
+        while low is None or high is None:  # proportional steps L_d L / f until the root is bracketed
+            r = residual(design_length)
+            if r < 0:
+                low = design_length
+            else:
+                high = design_length
+            if low is not None and high is not None:
+                break
+            step = design_length * asked / (r + asked)
+            if r < 0:  # longer: stay within the lengths the rule designs
+                if not longest:
+                    longest.append(longest_design_length(scene, design_length, points, fraction))
+                limit = longest[0]
+                if limit is not None and step >= limit:
+                    if design_length >= limit:  # the longest design is short of L: no design reaches it
+                        reason = _limit_reason(scene, limit, points, fraction)
+                        raise SceneError("recoil_length", f"{asked:g} m is too long: the longest recoil a constant-"
+                                                          f"resistance brake gives on this scene is "
+                                                          f"{asked + r:.6g} m (designed for {limit:.6g} m; {reason})")
+                    step = limit
+            design_length = step
+        # f is monotonic in L_d: Brent's method inside the bracket, stopped by the first run within tolerance
+        brentq(residual, low, high, xtol=1e-12 * asked, maxiter=max_iterations, disp=False)
+    except _Hit as hit:
+        return LengthDesign(hit.design, hit.result, asked, tolerance, iterations)
+    except _OutOfRuns:
+        pass
     best = min(iterations, key=lambda pair: abs(pair[1] - asked))
     raise SimulationError(f"the brake design did not converge to the recoil length {asked:g} m within "
                           f"{tolerance:.3g} m in {max_iterations} simulations: the closest, designed for "
@@ -172,15 +202,3 @@ def _limit_reason(scene: Scene, limit: float, points: int, fraction: float) -> s
         reason = exc.message
         return reason.split(": ", 1)[1] if "too long: " in reason else reason
     return "the closed form's limit"
-
-
-def _next_length(length: float, residual: float, asked: float, previous, low, high) -> float:
-    """The next design length (m): the secant through the last two iterates when it stays inside the bracket
-    (bisection when it would leave it), the proportional step ``L_d L / f`` before the root is bracketed."""
-    if low is None or high is None:
-        return length * asked / (residual + asked)
-    candidate = None
-    if previous is not None and residual != previous[1]:
-        candidate = length - residual * (length - previous[0]) / (residual - previous[1])
-    inside = candidate is not None and min(low[0], high[0]) < candidate < max(low[0], high[0])
-    return candidate if inside else 0.5 * (low[0] + high[0])
