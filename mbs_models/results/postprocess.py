@@ -121,8 +121,8 @@ def analyse(mechanism, s: Samples, impact_threshold: float, wanted: tuple[str, .
                                        k_support if refine_support else None)
     for connector in mechanism.contacts:
         if connector.name in episodes:
-            metrics.contacts[connector.name] = _contact_output(mechanism, connector, s, episodes[connector.name],
-                                                               impact_threshold)
+            metrics.contacts[connector.name] = _contact_output(mechanism, connector, s,
+                                                               episodes[connector.name], impact_threshold)
         else:  # the history only
             metrics.contacts[connector.name] = ContactOutput(connector.name, connector.element, s.forces[connector.name],
                                                              None, None, None)
@@ -180,7 +180,8 @@ def shot_outputs(mechanism, s: Samples, interp: Interpolant) -> list[dict] | Non
     return out
 
 
-def _contact_output(mechanism, connector, s: Samples, episodes: Episodes, impact_threshold: float) -> ContactOutput:
+def _contact_output(mechanism, connector, s: Samples, episodes: Episodes,
+                    impact_threshold: float) -> ContactOutput:
     """The episodes, impacts (:func:`impact_mask`) and refined peak force of one contact.
 
     The peak is the strongest impact's; failing that (no impact, or the sample maximum above every

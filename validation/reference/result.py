@@ -498,7 +498,7 @@ class ReferenceResult:
         """The episodes of contact ``name`` that are impacts (DESIGN.md, "Outputs every scene gets"): the peak
         force rises above the force the contact held at rest when the episode began
         (:meth:`force_at_rest_before`) by more than ``impact_threshold``.  A preload holding the barrel on its
-        battery stop from t = 0 is then no impact (unless something presses it harder)."""
+        stop from t = 0 is then no impact (unless something presses it harder)."""
         return [e for e in self._episodes[name]
                 if e.peak_force - self.force_at_rest_before(name, e.start) > self.impact_threshold]
 
