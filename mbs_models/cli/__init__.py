@@ -222,7 +222,7 @@ def build_parser() -> argparse.ArgumentParser:
     validate.add_argument("--accuracy", default="standard", choices=("draft", "standard", "reference"),
                           help=ACCURACY_HELP)
     validate.add_argument("--impact-threshold", type=float, default=1000.0,
-                          help="peak force (N) above which a contact episode counts as an impact (default 1000)")
+                          help=run.IMPACT_THRESHOLD_HELP)
     validate.add_argument("--json", action="store_true", help="print the comparison as JSON")
     add_set_argument(validate)
     validate.set_defaults(handler=_cmd_validate)

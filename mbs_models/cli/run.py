@@ -10,6 +10,11 @@ from __future__ import annotations
 
 import json
 
+#: What ``--impact-threshold`` means (DESIGN.md, "Outputs every scene gets": which episodes are impacts).
+IMPACT_THRESHOLD_HELP = ("a contact episode counts as an impact when its peak force rises by more than this (N) above "
+                         "the force at rest it began with (0 unless a preload holds the contact at t = 0; default "
+                         "1000)")
+
 
 def add_parser(sub, accuracy_help: str) -> None:
     """The ``run`` subcommand's arguments."""
@@ -31,7 +36,7 @@ def add_parser(sub, accuracy_help: str) -> None:
     run.add_argument("--user-functions", choices=("symbolic", "python"), default=None,
                      help="user-function backend (default symbolic; python is slower, for debugging)")
     run.add_argument("--impact-threshold", type=float, default=1000.0,
-                     help="peak force (N) above which a contact episode counts as an impact (default 1000)")
+                     help=IMPACT_THRESHOLD_HELP)
     add_set_argument(run)
     run.set_defaults(handler=command)
 

@@ -497,6 +497,12 @@ class ContactConnector(Connector):
         """The undamped force (N) at a penetration (m): ``k p^n`` (``k p``)."""
         return self.contact_stiffness * penetration ** self.exponent
 
+    def elastic_force(self, d: float) -> float:
+        """The force at rest (N, ``p' = 0``) at ``d`` (m, a float): ``k p^n`` (``k p`` for Kelvin-Voigt) for
+        ``p = d - offset > 0``, else 0 -- the static force an initial interference starts from."""
+        p = d - self.offset
+        return self.peak_force_estimate(p) if p > 0.0 else 0.0
+
     def impact_penetration(self, reduced_mass: float, speed: float) -> float:
         """Maximum penetration (m) of an undamped impact of ``reduced_mass`` (kg) at ``speed`` (m/s):
         ``((n+1) m v^2 / (2 k))^(1/(n+1))``."""

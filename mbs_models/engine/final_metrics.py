@@ -54,7 +54,15 @@ Finality (what :class:`FinalityTracker` decides from the states it is shown)
 * ``max_absorber_velocity``: once every absorber's velocity bound <= the largest velocity it had;
 * ``peak_contact_force``: once every contact (absorbers and stops) is unreachable or its force bound
   <= the largest force it had;
-* ``impacts``: once every contact's force bound <= the impact threshold and no contact is going on;
+* ``impacts``: once every contact's force bound <= the impact threshold and no contact is going on.  An
+  impact is an episode whose peak rises above the force the contact held at rest when it began by more
+  than the threshold (0 for an episode beginning inside the window, ``k p(0)^n`` for one going on at
+  t = 0).  With every contact open, every episode so far is closed, so its record and whether it is an
+  impact are those of the full run; every later episode begins inside the window, from 0 N, and peaks
+  at most at the bound: no impact.  A contact going on blocks it: its episode's end is not known yet,
+  and even a preload's hold from t = 0 (no impact) could still open and a new episode begin (telling
+  the hold from a later episode would take the history of every sample, which the tracker, shown only
+  some states, does not have).  So a preload resting on its stop keeps ``impacts`` from being final;
 * ``peak_support_force``: once the bound on |S| <= the largest |S| seen.
 
 Ties keep the earliest time, as the peak refinement does.  The observed values are samples of the

@@ -427,7 +427,9 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
     end_time: simulated time in s, in (0, 1e4]; the paper uses 10 s.
     accuracy: ``"draft"``, ``"standard"`` (default) or ``"reference"``, or a :class:`SolverSettings`.
     user_functions: override the settings' backend: ``"symbolic"`` (C++) or ``"python"``.
-    impact_threshold: a contact episode counts as an impact when its peak force exceeds this (N).
+    impact_threshold: a contact episode counts as an impact when its peak force rises above the force the
+        contact held at rest when it began (0, or at t = 0 an initial interference's ``k p^n``) by more than
+        this (N).
     stop_when_final: metric names among :data:`~mbs_models.engine.final_metrics.FINAL_METRICS`
         (``"max_barrel_displacement"``, ``"peak_contact_force"``, ``"max_absorber_velocity"``,
         ``"impacts"``).  The solve stops as soon as energy bounds prove that none of them can change
@@ -452,8 +454,9 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
       ``dissipated_energy_history``, ``work_histories``; J) and :meth:`~Result.energy_error`;
     * metrics, refined between samples: ``max_barrel_displacement`` (m) and its time,
       ``peak_support_force`` (N), ``peak_contact_force`` (N) and ``max_absorber_velocity`` (m/s) over all
-      absorbers, each with its time; ``impacts`` (contact episodes above ``impact_threshold``, in time
-      order); ``dissipated_energy`` (J per connector); :meth:`~Result.absorbers`, :meth:`~Result.stops`,
+      absorbers, each with its time; ``impacts`` (the absorbers' contact episodes that rise by more
+      than ``impact_threshold`` above their force at rest, in time order); ``dissipated_energy`` (J per
+      connector); :meth:`~Result.absorbers`, :meth:`~Result.stops`,
       :meth:`~Result.energy` per element; ``max_at_end_of_window`` (the maximum is the window's last
       instant, not a turning point);
     * the run: ``end_time`` and ``requested_end_time`` (s), ``stop_reason``, ``final_metrics``,

@@ -26,14 +26,26 @@ def contact_episodes(mechanism, connector, s: Samples, force: np.ndarray, interp
     return refine(mechanism, s.time, {connector.name: force}, interp, [connector], threshold)[0][connector.name]
 
 
+def initial_static_force(mechanism, connector, s: Samples) -> float:
+    """The force (N) a contact holds at rest at the first sample: its law at ``p' = 0``, ``k p(0)^n``
+    (0 unless an initial interference) -- what an episode going on from t = 0 rises from."""
+    return connector.elastic_force(float(mechanism.relative(connector, {n: x[0] for n, x in s.positions.items()})))
+
+
+def impact_mask(mechanism, connector, s: Samples, episodes: Episodes, threshold: float) -> np.ndarray:
+    """Which of a contact's episodes are impacts: their peak rises above the force they start from at rest
+    by more than ``threshold`` N (:meth:`~mbs_models.results.refinement.Episodes.impact_mask`)."""
+    return episodes.impact_mask(threshold, initial_static_force(mechanism, connector, s))
+
+
 def find_impacts(mechanism, connector, s: Samples, force: np.ndarray, interp: Interpolant,
                  threshold: float) -> tuple[list[Impact], list[Impact]]:
-    """Contact episodes of one contact (maximal intervals with force > 0): (all, those whose peak
-    exceeds ``threshold`` N).  Peaks are refined on the law over the interpolated state
+    """Contact episodes of one contact (maximal intervals with force > 0): (all, the impacts among them,
+    :func:`impact_mask`).  Peaks are refined on the law over the interpolated state
     (:func:`~mbs_models.results.refinement.refine`)."""
     episodes = contact_episodes(mechanism, connector, s, force, interp, threshold)
     return (episodes.impacts(connector.name),
-            episodes.impacts(connector.name, episodes.peak_force > threshold))
+            episodes.impacts(connector.name, impact_mask(mechanism, connector, s, episodes, threshold)))
 
 
 @dataclass
@@ -109,8 +121,8 @@ def analyse(mechanism, s: Samples, impact_threshold: float, wanted: tuple[str, .
                                        k_support if refine_support else None)
     for connector in mechanism.contacts:
         if connector.name in episodes:
-            metrics.contacts[connector.name] = _contact_output(connector, s, episodes[connector.name],
-                                                               impact_threshold)
+            metrics.contacts[connector.name] = _contact_output(mechanism, connector, s,
+                                                               episodes[connector.name], impact_threshold)
         else:  # the history only
             metrics.contacts[connector.name] = ContactOutput(connector.name, connector.element, s.forces[connector.name],
                                                              None, None, None)
@@ -168,14 +180,15 @@ def shot_outputs(mechanism, s: Samples, interp: Interpolant) -> list[dict] | Non
     return out
 
 
-def _contact_output(connector, s: Samples, episodes: Episodes, impact_threshold: float) -> ContactOutput:
-    """The episodes, impacts and refined peak force of one contact.
+def _contact_output(mechanism, connector, s: Samples, episodes: Episodes,
+                    impact_threshold: float) -> ContactOutput:
+    """The episodes, impacts (:func:`impact_mask`) and refined peak force of one contact.
 
     The peak is the strongest impact's; failing that (no impact, or the sample maximum above every
     impact's peak) the refined peak of the episode holding the sample maximum.
     """
     force = s.forces[connector.name]
-    impacts = episodes.impacts(connector.name, episodes.peak_force > impact_threshold)
+    impacts = episodes.impacts(connector.name, impact_mask(mechanism, connector, s, episodes, impact_threshold))
     k = int(np.argmax(force))
     if impacts and max(i.peak_force for i in impacts) >= force[k]:
         strongest = max(impacts, key=lambda i: i.peak_force)  # already refined

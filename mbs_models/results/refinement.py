@@ -3,10 +3,10 @@
 A contact episode is a maximal run of samples with force > 0.  For every episode of every contact its
 peak is refined near its largest sample (:func:`~mbs_models.results.peaks.maxima_near_samples`: the law
 on the Hermite-interpolated state, nested grids over the two sample intervals beside it); for every
-episode whose peak exceeds the impact threshold, its start and end are refined to the first time the
-force is > 0 after the sample before it and the first time it is <= 0 after its last sample
-(:func:`~mbs_models.results.nested_grids.first_true_search`).  The largest |support force| is refined
-the same way near its largest sample.
+episode whose peak exceeds the impact threshold (every impact among them: :meth:`Episodes.impact_mask`),
+its start and end are refined to the first time the force is > 0 after the sample before it and the first
+time it is <= 0 after its last sample (:func:`~mbs_models.results.nested_grids.first_true_search`).  The
+largest |support force| is refined the same way near its largest sample.
 
 All these searches run in lockstep (:func:`~mbs_models.results.nested_grids.run`): the peaks of every
 contact's episodes and the support peak are one nested-grid search over all their brackets, the
@@ -48,6 +48,16 @@ class Episodes:
     time_of_peak_force: np.ndarray
     start: np.ndarray
     end: np.ndarray
+
+    def impact_mask(self, threshold: float, initial_force: float = 0.0) -> np.ndarray:
+        """Which episodes are impacts (DESIGN.md, "Outputs every scene gets"): those whose peak force rises
+        above the force they start from at rest by more than ``threshold`` (N), ``peak - B > threshold``.
+        ``B`` is 0 for an episode that begins inside the window (the force was 0 just before it: the bodies
+        came together) and ``initial_force`` (N: the contact's force at rest at t = 0, ``k p(0)^n``) for the
+        episode already going on at the first sample (an initial interference): a preload resting on its
+        stop is not an impact, an interference approached at t = 0 is one once its force rises enough."""
+        baseline = np.where(self.first == 0, initial_force, 0.0)
+        return self.peak_force - baseline > threshold
 
     def impacts(self, contact: str, mask=None) -> list[Impact]:
         """The episodes (those in ``mask``) as :class:`Impact` records."""

@@ -16,7 +16,8 @@ ALL_METRICS = ("max_barrel_displacement", "peak_contact_force", "max_absorber_ve
 
 @dataclass(frozen=True)
 class Impact:
-    """One contact episode whose peak force exceeds the threshold.
+    """One contact episode that is an impact: its peak force rises above the force the contact held at rest
+    when it began (0, or an initial interference's static force) by more than the impact threshold.
 
     Attributes: ``start`` and ``end`` (s) bound the interval where the contact force is > 0;
     ``peak_force`` (N) is its maximum, reached at ``time_of_peak_force`` (s); ``contact`` names the
@@ -44,7 +45,7 @@ class ContactOutput:
     """One contact of a run: its force history (N, at the output times), refined peak and impacts.
 
     ``element`` is the element it belongs to (the absorber's name, a stop's...); ``episodes`` the
-    number of contact episodes (force > 0), ``impacts`` those above the threshold; ``onsets``: for laws
+    number of contact episodes (force > 0), ``impacts`` those that are impacts (:class:`Impact`); ``onsets``: for laws
     that use it, ``(time s, v- m/s)`` at the onset of each episode as captured in the solve.
     ``peak_force``/``impacts`` are None when an early-stopped run did not prove them final.
     """

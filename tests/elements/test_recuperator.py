@@ -12,11 +12,13 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
 import tomllib
+from scipy.integrate import quad
 
 from mbs_models import (Barrel, BatteryStop, Firing, RecoilDamper, RecoilSpring, RecoilStop,
                         Recuperator, Scene, SceneError, load_scene, model_i, model_ii, simulate)
@@ -298,11 +300,99 @@ def test_without_a_shot_nothing_moves_for_a_second(law, base):
     assert np.max(np.abs(result.support_force)) < 1e-6
     x0 = result.barrel_position[0]  # the stop carries the preload less the recoil spring's pull
     assert result.contacts["battery_stop"].force[-1] == pytest.approx(gas_force(GAS, x0) + 27500.0 * x0, rel=1e-9)
+    # that static contact (~1.98 kN, above the 1 kN threshold) is an episode, not an impact (DESIGN.md)
+    assert result.contacts["battery_stop"].episodes == 1 and result.contacts["battery_stop"].impacts == []
     reference = solve_reference(scene.with_changes(recoil_damper=None), 1.0, max_segments=500)
     t = np.linspace(0.0, 1.0, 1001)
     for body in reference.bodies:
         x = reference.position(body, t)
         assert np.max(np.abs(x - x[0])) < 1e-9, body
+    assert len(reference.contacts["battery_stop"].episodes) == 1 and reference.contacts["battery_stop"].impacts == []
+
+
+# ------------------------------------------------------------------ the hold is no impact, the landings are
+def test_the_example_at_rest_without_a_shot_has_no_impact():
+    """Without a shot the barrel stays in battery: the stop carries the 2 kN preload for the whole run, above the
+    1 kN threshold, in one episode that never rises above its static value: no impact (DESIGN.md, "Outputs
+    every scene gets"), in the engine and in the reference; ``recoil run``'s outputs say so."""
+    scene = at_rest(EXAMPLE)
+    result = simulate(scene, 2.0)
+    contact = result.contacts["battery_stop"]
+    static = gas_force(GAS, result.barrel_position[0])
+    assert np.all(np.abs(contact.force - static) < 1e-6 * static) and static > 1000.0
+    assert contact.episodes == 1 and contact.impacts == [] and result.stops()[0]["impacts"] == []
+    assert result.metrics()["stops"][0]["impacts"] == [] and ", 0 impacts" in result.summary()
+    reference = solve_reference(scene, 2.0)
+    [hold] = reference.contacts["battery_stop"].episodes
+    assert hold.start == 0.0 and hold.end == 2.0 and hold.peak_force == pytest.approx(static, rel=1e-9)
+    assert reference.contacts["battery_stop"].impacts == [] == reference.stop_metrics["battery_stop"].impacts
+
+
+def landings(time, barrel_position, barrel_velocity, position: float = 0.0) -> list[tuple[float, float]]:
+    """``(time s, approach speed m/s)`` of every landing onto a battery stop at ``position`` in a sampled
+    trajectory: x_M from >= position to < position (the penetration ``position - x_M`` turns positive: an onset
+    inside the window), interpolated linearly to the crossing."""
+    x = np.asarray(barrel_position) - position
+    out = []
+    for i in np.flatnonzero((x[:-1] >= 0.0) & (x[1:] < 0.0)):
+        w = x[i] / (x[i] - x[i + 1])
+        out.append((float(time[i] + w * (time[i + 1] - time[i])),
+                    float(-(barrel_velocity[i] + w * (barrel_velocity[i + 1] - barrel_velocity[i])))))
+    return out
+
+
+@pytest.fixture(scope="module")
+def realistic_runs():
+    scene = load_scene(scene_path("realistic"))
+    return scene, simulate(scene, 10.0), solve_reference(scene, 10.0)
+
+
+def test_the_realistic_preloads_hold_is_an_episode_not_an_impact(realistic_runs):
+    """The realistic scene starts at rest on its Kelvin-Voigt buffer in static equilibrium (DESIGN.md, "Initial
+    state"): the buffer carries the preload less the weight along the cradle, ``F(x0) - M g sin(30 deg)`` =
+    8.5 kN, far above the 1 kN threshold.  The breech pulse only pulls the barrel off the stop, so the force never
+    rises above that static value: the hold is an episode (the old definition counted it) but not an impact."""
+    scene, result, reference = realistic_runs
+    force = result.contacts["battery_stop"].force
+    x0 = result.barrel_position[0]
+    static = gas_force(scene.recuperator, x0) - scene.barrel.mass * G * math.sin(math.radians(30.0))
+    assert result.barrel_velocity[0] == 0.0 and x0 < 0.0
+    assert force[0] == pytest.approx(static, rel=1e-6) and static > 8000.0  # (Brent's root of the equilibrium)
+    off = np.flatnonzero(force <= 0.0)[0]  # the first sample the barrel is off the stop
+    assert np.max(force[:off]) == force[0]  # the pulse only unloads the stop
+    assert all(impact.start > 0.0 for impact in result.contacts["battery_stop"].impacts)
+    hold = reference.contacts["battery_stop"].episodes[0]
+    assert hold.start == 0.0 and hold.peak_force == pytest.approx(static, rel=1e-6)
+    assert hold not in reference.contacts["battery_stop"].impacts
+
+
+def test_the_realistic_buffer_counts_the_hit_and_the_rebound_of_every_return(realistic_runs):
+    """After each of the 3 shots the recuperator brings the barrel back onto the buffer (at ~0.16 m/s), the
+    buffer throws it back out, and it lands again (~0.05 m/s), after which the preload holds it on the stop until
+    the next shot (or the end of the window).  Each landing is an onset inside the window (force at rest 0 before
+    it) at which a Kelvin-Voigt law's force jumps to ``c v-`` (c = 2e5 N s/m): a landing faster than threshold /
+    c = 5 mm/s is an impact.  So 2 impacts per return, 6 for the 3 shots; the last one (the third shot's
+    rebound) is still going on at the end of the window and counts once.  The same in the reference."""
+    scene, result, reference = realistic_runs
+    stop = scene.battery_stop
+    contact = result.contacts["battery_stop"]
+    found = landings(result.time, result.barrel_position, result.barrel_velocity, stop.position)
+    shots = [shot["time"] for shot in result.shots] + [result.end_time]
+    per_shot = [[o for o in found if a < o[0] < b] for a, b in zip(shots, shots[1:])]
+    assert [len(returns) for returns in per_shot] == [2, 2, 2]
+    assert all(stop.damping * speed > 5000.0 for _, speed in found)  # clearly impacts
+    assert all(hit[1] > rebound[1] for hit, rebound in per_shot)  # the rebound comes back slower
+    assert len(contact.impacts) == 6 and contact.episodes == 7  # + the hold at t = 0
+    interval = float(np.max(np.diff(result.time)))
+    for impact, (time, _) in zip(contact.impacts, found):  # each impact begins at its landing
+        assert abs(impact.start - time) <= interval
+    assert contact.impacts[-1].end == result.end_time  # at rest on the stop since the last rebound
+    assert result.metrics()["stops"][0]["impacts"] == [impact.to_dict() for impact in contact.impacts]  # --json
+    assert re.search(r"\n  battery stop +[0-9.]+ kN, 6 impacts\n", result.summary())  # recoil run's text
+    theirs = reference.contacts["battery_stop"]
+    assert len(theirs.episodes) == 7 and theirs.impacts == theirs.episodes[1:]
+    for ours, its in zip(contact.impacts, theirs.impacts):
+        assert abs(ours.start - its.start) <= TOLERANCES["standard"]["time"]
 
 
 # ------------------------------------------------------------------ energy
@@ -321,7 +411,15 @@ def test_the_recuperator_alone_is_conservative():
     assert np.max(np.abs(result.energy_error())) < 2e-9 * e0  # with the stop's quadrature (measured 9.8e-10)
     assert result.dissipated_energy["battery_stop"] == pytest.approx(0.0, abs=1e-9 * e0)
     assert result.max_barrel_displacement == pytest.approx(x_max, rel=1e-9)
-    assert len(result.contacts["battery_stop"].impacts) >= 2  # it bounces back from the stop, again and again
+    # the hold on the stop at t = 0 is an episode but no impact (DESIGN.md: its force never rises above the static
+    # preload); the barrel leaves the stop within p_s / v0 and comes back after its flight out and back under the
+    # gas alone, 2 integral_0^x_max dx / v(x) with M v^2 / 2 = E0 - U_gas(x) (x = x_max (1 - s^2) removes the
+    # 1/sqrt at the turning point); rebounding elastically it would land again a flight later, after the 3 s
+    flight = 2 * quad(lambda s: 2 * x_max * s / math.sqrt(
+        max(2 * (e0 - gas_energy(GAS, x_max * (1 - s * s))) / 5600.0, 1e-300)), 0.0, 1.0, limit=200)[0]
+    contact = result.contacts["battery_stop"]
+    assert contact.episodes == 2 and len(contact.impacts) == 1 and 2 * flight > 3.0
+    assert flight < contact.impacts[0].start < flight - x0 / 0.6909 + 1e-6  # measured 2.32575 s + 0.23 ms
     reference = solve_reference(ALONE, 3.0, rtol=1e-12, atol=1e-14)
     t = np.linspace(0.0, 3.0, 3001)
     mechanical = sum(reference.kinetic_energy(t).values()) + sum(reference.stored_energy(t).values())

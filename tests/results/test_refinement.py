@@ -7,7 +7,7 @@ import pytest
 
 from mbs_models import load_scene, model_ii, simulate
 from mbs_models.engine import simulation
-from mbs_models.results.refinement import refine
+from mbs_models.results.refinement import Episodes, refine
 from mbs_models.results.samples import Interpolant
 from mbs_models.engine.mechanism import Mechanism
 from mbs_models.scenes import list_scenes, scene_path
@@ -72,3 +72,25 @@ def test_contacts_together_equal_contacts_alone(name):
         alone = refine(mechanism, s.time, s.forces, interp, [contact], 1000.0)[0][contact.name]
         for field in ("first", "last", "k", "peak_force", "time_of_peak_force", "start", "end"):
             assert np.array_equal(getattr(together[contact.name], field), getattr(alone, field)), (contact.name, field)
+
+
+def _episodes(first, peaks) -> Episodes:
+    """Episodes with these first samples and peak forces (N); the other fields do not decide impacts."""
+    first, peaks = np.array(first), np.array(peaks, dtype=float)
+    return Episodes(first=first, last=first + 1, k=first, peak_force=peaks, time_of_peak_force=first * 1e-3,
+                    start=first * 1e-3, end=first * 1e-3 + 1e-3)
+
+
+def test_an_impact_rises_by_the_threshold_above_the_force_at_rest_it_began_with():
+    """DESIGN.md: ``peak - B > threshold``; B = 0 for an episode beginning inside the window, the contact's
+    force at rest at t = 0 for the one going on at the first sample.  Hand-made episodes, threshold 1 kN."""
+    # a 8.5 kN preload's hold that never rises, an onset at 5 kN, an onset at 1 kN exactly (not above)
+    held = _episodes([0, 40, 90], [8500.0, 5000.0, 1000.0])
+    assert held.impact_mask(1000.0, 8500.0).tolist() == [False, True, False]
+    # the same hold pressed 1.5 kN harder is an impact; 0.5 kN harder is not
+    assert _episodes([0], [10000.0]).impact_mask(1000.0, 8500.0).tolist() == [True]
+    assert _episodes([0], [9000.0]).impact_mask(1000.0, 8500.0).tolist() == [False]
+    # without an initial interference (B = 0) the rule is the peak above the threshold, at t = 0 too
+    assert held.impact_mask(1000.0).tolist() == [True, True, False]
+    # the force at rest at t = 0 concerns only the episode going on at the first sample
+    assert _episodes([3, 50], [8500.0, 8500.0]).impact_mask(1000.0, 8500.0).tolist() == [True, True]

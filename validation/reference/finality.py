@@ -39,7 +39,12 @@ A metric is final once its observed maximum (a lower bound of the true one: valu
 solver's step points) reaches the bound of everything later: ``max_barrel_displacement`` (x of the barrel),
 ``max_absorber_velocity`` (every absorber's v), ``peak_contact_force`` (every contact's force: absorbers
 and stops), ``peak_support_force`` (|S|), ``impacts`` (every contact: no episode going on and its force
-bound below the impact threshold).
+bound below the impact threshold).  For ``impacts`` (an episode is one when its peak rises above the force
+the contact held at rest when it began by more than the threshold -- 0 for an episode that begins inside
+the window): every episode of an open contact is over, with the full run's record; every later one begins
+inside the window from 0 N and peaks at most at the bound, so it is no impact.  A contact in an episode is
+never final: the episode's end is still to come, and a preload's hold from t = 0 (no impact itself) may
+still open and a new episode begin.
 """
 
 from __future__ import annotations
@@ -356,8 +361,8 @@ class Finality:
         """Relative margin ``(observed - bound) / |observed|`` per metric in ``names`` (default: the
         requested ones) not yet final: the smallest over its items not yet final; final once >=
         -:data:`ROOT_TOLERANCE`.  ``mode``: the current segment's (a contact with a force is in an episode,
-        whose impact is not decided yet).  ``continuous`` leaves out the own-energy refinement (see
-        :meth:`EnergyBounds.bounds`)."""
+        whose end, and for a hold from t = 0 what follows it, is not known yet).  ``continuous`` leaves out
+        the own-energy refinement (see :meth:`EnergyBounds.bounds`)."""
         names = self.requested if names is None else names
         energy = self.energy_bounds.with_slack(float(self.model.mechanical_energy(y)))
         b = self.energy_bounds.bounds(energy, y, continuous)

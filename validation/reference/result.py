@@ -49,8 +49,9 @@ class ReferenceSegment:
 
 @dataclass(frozen=True)
 class ReferenceImpact:
-    """A contact episode (maximal interval with F > 0) of contact ``contact``; with a peak above the impact
-    threshold it is an impact.  start, end, time_of_peak in s; peak_force in N."""
+    """A contact episode (maximal interval with F > 0) of contact ``contact``; it is an impact when its peak
+    rises above the force the contact held at rest when it began by more than the impact threshold
+    (:meth:`ReferenceResult.force_at_rest_before`).  start, end, time_of_peak in s; peak_force in N."""
 
     start: float
     end: float
@@ -66,7 +67,7 @@ class ReferenceImpact:
 
 @dataclass(frozen=True)
 class ContactMetrics:
-    """One contact: its peak force (N) and time (s), episodes, impacts (above the threshold) and onsets
+    """One contact: its peak force (N) and time (s), episodes, impacts (those rising above the threshold) and onsets
     ``(t, v-)`` (s, m/s: the start of every interval with p > 0 and p' there).  Peak and impacts are None
     when an early stop did not prove them final."""
 
@@ -483,8 +484,23 @@ class ReferenceResult:
         best = max(episodes, key=lambda e: (e.peak_force, -e.time_of_peak))
         return (best.time_of_peak, best.peak_force)
 
+    def force_at_rest_before(self, contact: str, start: float) -> float:
+        """The force (N) that contact ``contact`` held at rest when an episode of it began at ``start`` (s): 0
+        for an episode that begins inside the window (the contact was open just before it), the static force
+        ``k p(0)^n`` of the initial penetration for an episode going on at t = 0 (an initial interference)."""
+        t0 = self.segments[0].t0
+        if start > t0:
+            return 0.0
+        c = self.model.connector(contact)
+        return c.static_force(float(c.d_of(self.state(t0))))
+
     def _impacts_of(self, name: str) -> list[ReferenceImpact]:
-        return [e for e in self._episodes[name] if e.peak_force > self.impact_threshold]
+        """The episodes of contact ``name`` that are impacts (DESIGN.md, "Outputs every scene gets"): the peak
+        force rises above the force the contact held at rest when the episode began
+        (:meth:`force_at_rest_before`) by more than ``impact_threshold``.  A preload holding the barrel on its
+        stop from t = 0 is then no impact (unless something presses it harder)."""
+        return [e for e in self._episodes[name]
+                if e.peak_force - self.force_at_rest_before(name, e.start) > self.impact_threshold]
 
     @cached_property
     def _support_max(self) -> tuple[float, float]:
@@ -626,7 +642,8 @@ class ReferenceResult:
 
     @property
     def impacts(self) -> list[ReferenceImpact] | None:
-        """Episodes of the absorbers' contacts whose peak force exceeds ``impact_threshold`` N, in time order
+        """The absorbers' contacts' impacts (episodes whose peak rises above the force at rest they began with by
+        more than ``impact_threshold`` N), in time order
         ([] without absorbers; None if the solve stopped before proving the list final)."""
         if not self._final("impacts"):
             return None

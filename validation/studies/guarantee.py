@@ -29,7 +29,8 @@ TOLERANCES = {
     "standard": {"energy": 5e-6, "metric": 1e-5, "force": 2e-5, "impact_peak": 1e-4, "time": 2e-5},
     "reference": {"energy": 5e-9, "metric": 2e-7, "force": 3e-7, "impact_peak": 5e-6, "time": 1e-6},
 }
-#: Impacts whose peak lies within this fraction of the threshold are ambiguous (either side may count).
+#: Impacts whose rise (the peak above the force at rest the episode began with) lies within this fraction of the
+#: threshold are ambiguous (either side may count).
 THRESHOLD_BAND = 1e-2
 
 #: The reference's tolerances per engine preset: at least 100x tighter than the errors checked.  Its
@@ -78,15 +79,17 @@ def merge_close(episodes, gap: float) -> list[tuple[float, float, float]]:
     return [tuple(m) for m in merged]
 
 
-def _impact_errors(ours_all, theirs_all, threshold: float, window: float, merge_gap: float) -> tuple[int, float, float]:
-    """(impacts on one side only, largest start/end error s, largest relative peak error) of one contact."""
+def _impact_errors(ours_all, theirs_all, threshold: float, window: float, merge_gap: float,
+                   initial_rest_force: float = 0.0) -> tuple[int, float, float]:
+    """(impacts on one side only, largest start/end error s, largest relative peak error) of one contact.
+    ``initial_rest_force`` (N): the force at rest an episode going on at t = 0 rises from (0 for the others)."""
     band = THRESHOLD_BAND * threshold
 
-    def clear(peak):
-        return abs(peak - threshold) > band
+    def clear(start, peak):
+        return abs(peak - (initial_rest_force if start <= 0.0 else 0.0) - threshold) > band
 
-    ours = [i for i in merge_close(ours_all, merge_gap) if i[0] <= window and clear(i[2])]
-    theirs = [e for e in merge_close(theirs_all, merge_gap) if clear(e[2])]
+    ours = [i for i in merge_close(ours_all, merge_gap) if i[0] <= window and clear(i[0], i[2])]
+    theirs = [e for e in merge_close(theirs_all, merge_gap) if clear(e[0], e[2])]
     mismatch = abs(len(ours) - len(theirs))
     time_error = peak_error = 0.0
     if not mismatch:
@@ -121,7 +124,7 @@ def errors_against_reference(result, ref, merge_gap: float = 0.0) -> dict:
     ``dissipated`` (per connector, relative to the initial energy), ``energy`` (the engine's own
     balance), ``time`` (impact start/end, s), ``peaks`` (impact peaks), and the integer
     ``impact_mismatch`` (impacts present on one side only, outside the ambiguous band around the
-    threshold, summed over the contacts).  Episodes separated by less than ``merge_gap`` s count as one
+    threshold of their rise, summed over the contacts).  Episodes separated by less than ``merge_gap`` s count as one
     (:func:`merge_close`).  Where the reference covers only the start of the run, a peak is the engine's
     refined one if it falls in that window, else the largest engine sample in it.
     """
@@ -160,7 +163,7 @@ def errors_against_reference(result, ref, merge_gap: float = 0.0) -> dict:
         peak = within(contact.peak_force, contact.time_of_peak_force, contact.force)
         out["F"] = max(out["F"], abs(peak - theirs.peak_force) / max(theirs.peak_force, 1.0))
         mismatch, time_error, peak_error = _impact_errors(contact.impacts, theirs.impacts, result.impact_threshold,
-                                                          window, merge_gap)
+                                                          window, merge_gap, ref.force_at_rest_before(name, 0.0))
         out["impact_mismatch"] += mismatch
         out["time"] = max(out["time"], time_error)
         out["peaks"] = max(out["peaks"], peak_error)

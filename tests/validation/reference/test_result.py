@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from mbs_models.elements.contact_laws import LawFields
-from mbs_models.scene import load_scene, model_i, model_ii, simplified_model
+from mbs_models.scene import Conventions, load_scene, model_i, model_ii, simplified_model
 from validation.reference import solve_reference
 from validation.reference.model import GROUND
 
@@ -214,6 +214,9 @@ def test_contact_episodes_and_onsets(solved):
             assert np.all(force[inside] <= e.peak_force * (1 + 1e-12))
         for a, b in zip(contact.episodes, contact.episodes[1:]):
             assert a.end <= b.start
+        # no episode here is going on at t = 0 (the shot clips the preloaded buffer's force at once), so each began
+        # from 0 N at rest and an impact is an episode peaking above the threshold
+        assert all(e.start > 0.0 for e in contact.episodes)
         assert contact.impacts == [e for e in contact.episodes if e.peak_force > 1000.0]
         c = r.model.connector(name)
         for time, v_minus in contact.onsets:  # onset: p = 0 turning positive at the rate v-
@@ -270,3 +273,15 @@ def test_sample_keys(solved):
         assert s[key].shape == (11,), key
     several = solved("two-absorbers").sample(5)
     assert "x_m" not in several and several["x:rear"].shape == (5,)
+
+
+# ------------------------------------------------------------------ which episodes are impacts (DESIGN.md)
+def test_an_initial_interference_approached_at_t0_is_an_impact():
+    """The paper's literal gap sign makes a 1 mm gap an interference that the barrel approaches at v0: at t = 0
+    Hunt-Crossley's ``k p^n (1 + lambda v0)`` exceeds the static ``k p^n`` by ``k p^n lambda v0`` (10.9 kN)."""
+    scene = model_ii(1000.0, 0.001, Conventions(literal_gap_sign=True))
+    r = solve_reference(scene, 0.5)
+    static = 2.1e8 * 0.001 ** 1.3
+    first = r.contacts["contact"].episodes[0]
+    assert first.start == 0.0 and first.peak_force - static > 10000.0
+    assert r.impacts[0] == first
