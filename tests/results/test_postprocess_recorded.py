@@ -43,6 +43,10 @@ SOLVE_CHANGED = {
                     "with tables whose points fall between steps)",
     "realistic": "issue #19: its pulse, as breech_pulse",
 }
+#: Runs in which a contact held at rest from t = 0 was counted as an impact before issue #19 redefined
+#: impacts (DESIGN.md: an episode going on at t = 0 is an impact only if its peak rises above the force it
+#: held by the threshold): run key -> the contact whose one recorded "impact" starting at t = 0 is dropped.
+HELD_AT_START = {"scene/realistic/standard/1000": "battery_stop"}
 
 
 def scene_of(key: str):
@@ -87,8 +91,25 @@ def test_matches_the_recorded_outputs(key):
     scales = record["scales"]
     if key.split("/")[0] == "scene" and key.split("/")[1] in SOLVE_CHANGED:
         new, record = metrics_only(new), metrics_only(record)
+    if key in HELD_AT_START:
+        record = without_the_hold(record, HELD_AT_START[key])
     problems = recorded.differences(new, record, recorded.kind_of_output, accuracy, scales)
     assert not problems, problems[:10]
+
+
+def without_the_hold(run: dict, contact: str) -> dict:
+    """The record with the impact of ``contact`` that starts at t = 0 removed (:data:`HELD_AT_START`): exactly one
+    such impact in the contact's list and in its stop's list of the metrics."""
+    import copy
+
+    run = copy.deepcopy(run)
+    lists = [run["contacts"][contact]["impacts"]]
+    lists += [stop["impacts"] for stop in run["metrics"]["stops"] if stop["name"] == contact]
+    for impacts in lists:
+        held = [i for i in impacts if i["start"] == 0.0]
+        assert len(held) == 1, held
+        impacts.remove(held[0])
+    return run
 
 
 def test_what_changed_since_the_recording_is_named():
