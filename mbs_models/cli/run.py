@@ -2,7 +2,8 @@
 
 Every output is checked before the solve (exit 2, nothing written, for a figure format other than
 png/pdf/svg or a missing or unwritable directory), and contacts that can never close are reported on
-stderr (:func:`mbs_models.engine.reach.contacts_out_of_reach`) before the solve too.
+stderr (:func:`mbs_models.engine.reach.contacts_out_of_reach`) before the solve too.  A run stopped at rest
+(:mod:`mbs_models.engine.rest`) says so on stderr, in one line.
 """
 
 from __future__ import annotations
@@ -32,6 +33,9 @@ def add_parser(sub, accuracy_help: str) -> None:
                      help="user-function backend (default symbolic; python is slower, for debugging)")
     run.add_argument("--impact-threshold", type=float, default=1000.0,
                      help="peak force (N) above which a contact episode counts as an impact (default 1000)")
+    run.add_argument("--no-stop-at-rest", dest="stop_at_rest", action="store_false",
+                     help="integrate to the end time even where the scene is proven at rest (by default a run "
+                          "longer than 100 s stops there and holds the rest state)")
     add_set_argument(run)
     run.set_defaults(handler=command)
 
@@ -59,7 +63,9 @@ def command(args) -> int:
         check_output_file(args.csv, key="--csv")
     warn_out_of_reach(scene)
     result = simulate(scene, args.end_time, args.accuracy, user_functions=args.user_functions,
-                      impact_threshold=args.impact_threshold)
+                      impact_threshold=args.impact_threshold, stop_at_rest=args.stop_at_rest)
+    if result.rest_note() is not None:
+        print(f"recoil: {result.rest_note()}", file=sys.stderr, flush=True)
     if args.plot:
         from ..results.plotting import plot_result, save_figure
         save_figure(plot_result(result), args.plot)
