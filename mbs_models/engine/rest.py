@@ -98,12 +98,11 @@ class RestState:
         self.threshold = float(threshold)
         self.well = well
         self._x_r, self._gamma = float(rest_well_position), float(gamma)
-        in_well = (lambda c: any(c is m for m in well.members)) if well is not None else (lambda c: False)
         self._kinetic = tuple((i, 0.5 * body.mass) for i, body in enumerate(mechanism.bodies))
         self._springs = tuple(connector_ends(mechanism, c) + (0.5 * c.linear_stiffness,) for c in mechanism.connectors
                               if c.quadratic_potential and not c.is_contact and c.linear_stiffness > 0)
         self._elastic = tuple(connector_ends(mechanism, c) + (c.python_elastic,) for c in mechanism.contacts
-                              if not in_well(c))
+                              if well is None or c not in well)
 
     @classmethod
     def of(cls, mechanism: Mechanism, tolerance: float, bounds: EnergyBounds | None = None) -> "RestState | None":
@@ -134,8 +133,7 @@ class RestState:
             if gamma is None:
                 return None
         for contact in mechanism.contacts:
-            if (well is None or not any(contact is m for m in well.members)) \
-                    and mechanism.relative_at(contact, positions) - contact.offset > 0.0:
+            if (well is None or contact not in well) and mechanism.relative_at(contact, positions) - contact.offset > 0.0:
                 return None  # closed at rest outside the well (an initial interference)
         threshold = min(0.5 * body.mass * tolerance * tolerance for body in mechanism.bodies)
         for i in range(n):
@@ -308,7 +306,8 @@ class RestWatch:
         forces = {name: tail(history, float(mechanism.connector[name].python_force(
             mechanism.relative_at(mechanism.connector[name], rest), 0.0))) for name, history in samples.forces.items()}
         return replace(samples, time=np.concatenate([samples.time, tail_time]),
-                       positions={b.name: tail(samples.positions[b.name], rest[i]) for i, b in enumerate(mechanism.bodies)},
+                       positions={b.name: tail(samples.positions[b.name], rest[i])
+                                  for i, b in enumerate(mechanism.bodies)},
                        velocities={name: tail(history, 0.0) for name, history in samples.velocities.items()},
                        accelerations={name: tail(history, 0.0) for name, history in samples.accelerations.items()},
                        forces=forces)

@@ -10,7 +10,9 @@ Contract
   ``end_time``, or produces NaN/inf never yields a result.  The one exception is asked for:
   ``stop_when_final`` stops the solve once energy bounds prove the named metrics final
   (:mod:`mbs_models.engine.final_metrics`); the result says so (``stop_reason``, ``requested_end_time``)
-  and holds None for every metric not proven final.  Bad arguments raise
+  and holds None for every metric not proven final.  A run longer than 100 s that energy bounds prove at
+  rest stops there too (:mod:`mbs_models.engine.rest`); its result still covers ``[0, end_time]``, holding
+  the rest state from ``rest_time`` on (``stop_reason == "at_rest"``).  Bad arguments raise
   :class:`~mbs_models.errors.SceneError` naming the argument.
 * Numerical safety (:mod:`mbs_models.engine.stability`): a fixed step that is unstable for the scene or
   would step over an impact is refused before solving (SceneError, key ``step``, with the safe
@@ -39,8 +41,9 @@ from ..scene import Scene
 from . import stability
 from .accuracy import MIN_RELATIVE_TOLERANCE, SolverSettings, solver_settings_for
 from .assembly import Assembly, assemble
-from .final_metrics import (ENERGY_SLACK, FINAL_METRICS, STOP_AT_REST, STOP_END_TIME, STOP_ENERGY_CHECK, STOP_METRICS_FINAL,
-                            STOP_NO_BOUND, FinalityTracker, check_metric_names, dissipative, largest_energy_rise)
+from .final_metrics import (ENERGY_SLACK, FINAL_METRICS, STOP_AT_REST, STOP_END_TIME, STOP_ENERGY_CHECK,
+                            STOP_METRICS_FINAL, STOP_NO_BOUND, FinalityTracker, check_metric_names, dissipative,
+                            largest_energy_rise)
 from .guard import StepBudget, step_budget
 from .mechanism import Mechanism
 from .rest import RestWatch
