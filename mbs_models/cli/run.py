@@ -3,12 +3,13 @@
 Every output is checked before the solve (exit 2, nothing written, for a figure format other than
 png/pdf/svg or a missing or unwritable directory); unit slips (implausible magnitudes, contacts that can
 never close: :mod:`mbs_models.engine.unit_slips`) are warned of by ``simulate`` before it solves, one line
-each on stderr.
+each on stderr.  A run stopped at rest (:mod:`mbs_models.engine.rest`) says so on stderr, in one line.
 """
 
 from __future__ import annotations
 
 import json
+import sys
 
 #: What ``--impact-threshold`` means (DESIGN.md, "Outputs every scene gets": which episodes are impacts).
 IMPACT_THRESHOLD_HELP = ("a contact episode counts as an impact when its peak force rises by more than this (N) above "
@@ -37,6 +38,9 @@ def add_parser(sub, accuracy_help: str) -> None:
                      help="user-function backend (default symbolic; python is slower, for debugging)")
     run.add_argument("--impact-threshold", type=float, default=1000.0,
                      help=IMPACT_THRESHOLD_HELP)
+    run.add_argument("--no-stop-at-rest", dest="stop_at_rest", action="store_false",
+                     help="integrate to the end time even where the scene is proven at rest (by default a run "
+                          "longer than 100 s stops there and holds the rest state)")
     add_set_argument(run)
     run.set_defaults(handler=command)
 
@@ -55,7 +59,9 @@ def command(args) -> int:
     if args.csv:
         check_output_file(args.csv, key="--csv")
     result = simulate(scene, args.end_time, args.accuracy, user_functions=args.user_functions,
-                      impact_threshold=args.impact_threshold)
+                      impact_threshold=args.impact_threshold, stop_at_rest=args.stop_at_rest)
+    if result.rest_note() is not None:
+        print(f"recoil: {result.rest_note()}", file=sys.stderr, flush=True)
     if args.plot:
         from ..results.plotting import plot_result, save_figure
         save_figure(plot_result(result), args.plot)

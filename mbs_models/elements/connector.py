@@ -75,6 +75,9 @@ class Connector:
     needs_user_function = False
     records_force = False
     is_contact = False
+    #: True for a law that can hold its bodies at rest anywhere in a band of positions (Coulomb friction): the
+    #: scene then has no single rest state, and a solve is not stopped at rest (:mod:`mbs_models.engine.rest`).
+    sticks = False
     #: True when the stored energy is the quadratic form ``linear_stiffness d^2 / 2`` (or none): the energy
     #: bounds of the early stop then use it as such.  False for a nonlinear potential, which may also be
     #: negative (the recuperator's gas spring): the bounds treat it separately.

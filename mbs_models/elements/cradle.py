@@ -186,6 +186,8 @@ class CradleFriction(Connector):
     regularised friction of ``ObjectConnectorCoordinateSpringDamperExt`` (no user function).
     """
 
+    sticks = True  # exact Coulomb holds the barrel anywhere its other forces stay within mu N
+
     def __init__(self, name: str, element: str, a: str, b: str, friction_force: float, friction_velocity: float):
         super().__init__(name, element, a, b)
         self.friction_force = float(friction_force)

@@ -102,6 +102,7 @@ STOP_END_TIME = "end_time"                  # reached the requested end time (no
 STOP_METRICS_FINAL = "metrics_final"        # every metric named in stop_when_final was proven final
 STOP_NO_BOUND = "end_time_no_energy_bound"  # early stop asked, but the scene injects energy (literal_lambda_sign)
 STOP_ENERGY_CHECK = "end_time_energy_check"  # stopped early, but the energy error exceeded the slack: re-solved
+STOP_AT_REST = "at_rest"                    # proven within the tolerance of the rest state: held to the end time
 #: The metrics :meth:`FinalityTracker.check` decides together.
 _CONTACT_METRICS = ("peak_contact_force", "impacts", "max_absorber_velocity")
 _CONTACT_METRICS_SET = frozenset(_CONTACT_METRICS)
@@ -171,6 +172,11 @@ class _QuadraticForm:
             return math.inf
         inside = components[self._keep]
         return 2.0 * float(np.sum(inside * inside / self._values[self._keep]))
+
+    def null_space(self) -> np.ndarray:
+        """Orthonormal columns spanning K's null space (the position changes no spring resists), shape
+        (bodies, dimension)."""
+        return self._vectors[:, ~self._keep]
 
 
 class PotentialWell:

@@ -66,10 +66,11 @@ class Simulator(FreshModels):
 
     def simulate(self, scene: Scene, end_time: float = 10.0, accuracy: str | SolverSettings = "standard", *,
                  user_functions: str | None = None, impact_threshold: float = 1000.0,
-                 stop_when_final: Sequence[str] = ()) -> Result:
+                 stop_when_final: Sequence[str] = (), stop_at_rest: bool = True) -> Result:
         """:func:`mbs_models.simulate` (same arguments, result and errors) on a kept system where one fits."""
         return simulate_with(self, scene, end_time, accuracy, user_functions=user_functions,
-                             impact_threshold=impact_threshold, stop_when_final=stop_when_final)
+                             impact_threshold=impact_threshold, stop_when_final=stop_when_final,
+                             stop_at_rest=stop_at_rest)
 
     # ------------------------------------------------------------------ what simulate_with calls
     def acquire(self, scene: Scene, user_functions: str, mechanism: Mechanism) -> Assembly:

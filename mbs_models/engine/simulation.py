@@ -10,7 +10,9 @@ Contract
   ``end_time``, or produces NaN/inf never yields a result.  The one exception is asked for:
   ``stop_when_final`` stops the solve once energy bounds prove the named metrics final
   (:mod:`mbs_models.engine.final_metrics`); the result says so (``stop_reason``, ``requested_end_time``)
-  and holds None for every metric not proven final.  Bad arguments raise
+  and holds None for every metric not proven final.  A run longer than 100 s that energy bounds prove at
+  rest stops there too (:mod:`mbs_models.engine.rest`); its result still covers ``[0, end_time]``, holding
+  the rest state from ``rest_time`` on (``stop_reason == "at_rest"``).  Bad arguments raise
   :class:`~mbs_models.errors.SceneError` naming the argument.
 * Numerical safety (:mod:`mbs_models.engine.stability`): a fixed step that is unstable for the scene or
   would step over an impact is refused before solving (SceneError, key ``step``, with the safe
@@ -39,11 +41,13 @@ from ..scene import Scene
 from . import stability
 from .accuracy import MIN_RELATIVE_TOLERANCE, SolverSettings, solver_settings_for
 from .assembly import Assembly, assemble
-from .final_metrics import (ENERGY_SLACK, FINAL_METRICS, STOP_END_TIME, STOP_ENERGY_CHECK, STOP_METRICS_FINAL, STOP_NO_BOUND,
-                            FinalityTracker, check_metric_names, dissipative, largest_energy_rise)
+from .final_metrics import (ENERGY_SLACK, FINAL_METRICS, STOP_AT_REST, STOP_END_TIME, STOP_ENERGY_CHECK,
+                            STOP_METRICS_FINAL, STOP_NO_BOUND, FinalityTracker, check_metric_names, dissipative,
+                            largest_energy_rise)
 from .guard import StepBudget, step_budget
 from .mechanism import Mechanism
 from .unit_slips import warn_unit_slips
+from .rest import RestWatch
 
 #: Longest simulated time accepted, in s.
 MAX_END_TIME = 1.0e4
@@ -359,16 +363,19 @@ def segment_plan(mechanism: Mechanism, end_time: float, settings: SolverSettings
 
 
 def _run_segments(assembly: Assembly, settings: SolverSettings, end_time: float,
-                  tracker: FinalityTracker | None) -> tuple[int, float, Samples]:
+                  tracker: FinalityTracker | None, rest: RestWatch | None = None) -> tuple[int, float, Samples]:
     """Solve a scene with shots or pulses segment by segment (:func:`segment_plan`).
 
     At each segment's start the shots firing then add their velocity jumps to the state; each segment
-    is one Exudyn solve from the previous one's end state.  Returns (steps, simulated end time s, samples).
+    is one Exudyn solve from the previous one's end state.  ``rest``: the segments are cut into chunks
+    too, and the solve ends once a chunk proves rest (:meth:`RestWatch.settle`; the samples then end at
+    the rest time).  Returns (steps, simulated end time s, samples).
     """
     mechanism, data = assembly.mechanism, assembly.mbs.systemData
     run: dict = {"end_time": end_time}
     segments, steps, simulated_end = [], 0, 0.0
-    for k, (t0, t1, segment_settings) in enumerate(segment_plan(mechanism, end_time, settings)):
+    plan = segment_plan(mechanism, end_time, settings)
+    for k, (t0, t1, segment_settings) in enumerate(plan if rest is None else rest.split(plan)):
         if k:
             q = np.array(data.GetODE2Coordinates(), dtype=float)
             v = np.array(data.GetODE2Coordinates_t(), dtype=float)
@@ -385,6 +392,10 @@ def _run_segments(assembly: Assembly, settings: SolverSettings, end_time: float,
         steps += n
         segments.append(_read_segment(assembly, settings, t0, accelerations))
         if tracker is not None and tracker.done:
+            break
+        settled = rest.settle(t0, t1, segments[-1]) if rest is not None else None
+        if settled is not None:
+            segments[-1], simulated_end = settled, rest.time
             break
     return steps, simulated_end, _collect(assembly, simulated_end, settings, segments=segments)
 
@@ -418,7 +429,7 @@ def _settings_after_stepped_over_contacts(mechanism: Mechanism, samples: Samples
 
 def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSettings = "standard", *,
              user_functions: str | None = None, impact_threshold: float = 1000.0,
-             stop_when_final: Sequence[str] = ()) -> Result:
+             stop_when_final: Sequence[str] = (), stop_at_rest: bool = True) -> Result:
     """Simulate ``scene`` from t = 0 to ``end_time`` (s) with Exudyn and return a :class:`Result`.
 
     Parameters
@@ -441,6 +452,13 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
         (``stop_reason == "end_time_no_energy_bound"``).  An early stop is trusted only if the run's
         energy-balance error stayed below the bounds' slack; otherwise the scene is re-solved to
         ``end_time`` (``stop_reason == "end_time_energy_check"``).  Empty (default): run to ``end_time``.
+    stop_at_rest: a run longer than 100 s (:data:`~mbs_models.engine.rest.CHECK_INTERVAL`) of an adaptive
+        solver stops once energy bounds prove every position within the settings' absolute tolerance (m) of
+        the rest state and every velocity within it (m/s) for all later time (:mod:`mbs_models.engine.rest`):
+        ``stop_reason == "at_rest"``, ``rest_time`` (s) the first output sample that proves it, and the
+        histories hold the rest state from there to ``end_time`` (``end_time`` is the requested one).
+        Scenes that never provably rest (undamped, a load that never ends, friction) run to ``end_time``.
+        False: always integrate to ``end_time``.
 
     Returns
     -------
@@ -493,7 +511,7 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
     if isinstance(scene, Scene):  # anything else: simulate_with's SceneError
         warn_unit_slips(scene, stacklevel=2)
     return simulate_with(FRESH_MODELS, scene, end_time, accuracy, user_functions=user_functions,
-                         impact_threshold=impact_threshold, stop_when_final=stop_when_final)
+                         impact_threshold=impact_threshold, stop_when_final=stop_when_final, stop_at_rest=stop_at_rest)
 
 
 class FreshModels:
@@ -514,12 +532,16 @@ FRESH_MODELS = FreshModels()
 
 def simulate_with(models: FreshModels, scene: Scene, end_time: float = 10.0,
                   accuracy: str | SolverSettings = "standard", *, user_functions: str | None = None,
-                  impact_threshold: float = 1000.0, stop_when_final: Sequence[str] = ()) -> Result:
+                  impact_threshold: float = 1000.0, stop_when_final: Sequence[str] = (),
+                  stop_at_rest: bool = True) -> Result:
     """:func:`simulate` with the Exudyn systems of ``models`` (:class:`FreshModels` or a
     :class:`~mbs_models.engine.reuse.Simulator`): the same contract."""
     _check_arguments(scene, end_time, impact_threshold)
+    if not isinstance(stop_at_rest, bool):
+        raise SceneError("stop_at_rest", f"must be True or False, got {stop_at_rest!r}")
     requested = check_metric_names(stop_when_final)
     settings = solver_settings_for(accuracy, user_functions)
+    rest_tolerance = settings.absolute_tolerance if stop_at_rest and settings.adaptive else None  # (as asked for)
     stability.check_settings(scene, settings, float(end_time))  # unsafe steps: SceneError before solving
     early_stop = bool(requested) and dissipative(scene)
     t_start = _time.perf_counter()
@@ -527,12 +549,13 @@ def simulate_with(models: FreshModels, scene: Scene, end_time: float = 10.0,
     while True:
         mechanism = Mechanism(scene)  # fresh: contacts carry the onset capture of one solve
         tracker = FinalityTracker(mechanism, requested, impact_threshold) if early_stop else None
+        rest = RestWatch.of(mechanism, rest_tolerance, float(end_time), tracker.bounds if tracker else None)
         assembly = models.acquire(scene, settings.user_functions, mechanism)
         t_assembled = _time.perf_counter()
         failed = True
         try:
-            if mechanism.breakpoints or mechanism.loads:
-                steps, simulated_end, samples = _run_segments(assembly, settings, float(end_time), tracker)
+            if mechanism.breakpoints or mechanism.loads or rest is not None:
+                steps, simulated_end, samples = _run_segments(assembly, settings, float(end_time), tracker, rest)
                 t_solved = _time.perf_counter()
             else:
                 initial_accelerations = _initial_accelerations(assembly)
@@ -554,6 +577,9 @@ def simulate_with(models: FreshModels, scene: Scene, end_time: float = 10.0,
             break
         settings = retry
     stopped = tracker is not None and tracker.done
+    at_rest = rest is not None and rest.time is not None
+    if at_rest:  # the rest state held to the end time (within the tolerance of the solution: rest.py)
+        samples = rest.hold(samples)
     final = FINAL_METRICS
     if stopped:  # which other metrics are final too: all of them are checked at the last state
         tracker.observe_last(float(samples.time[-1]), [float(samples.positions[b.name][-1]) for b in mechanism.bodies],
@@ -578,7 +604,8 @@ def simulate_with(models: FreshModels, scene: Scene, end_time: float = 10.0,
     floor = tracker.bounds.energy_floor if stopped else 0.0  # the energy's lower bound (a preload's well)
     if stopped and largest_energy_rise(mechanical - floor) > ENERGY_SLACK:
         # the solution's energy rose by more than the bounds' slack: do not trust the early stop
-        result = simulate_with(models, scene, end_time, settings, impact_threshold=impact_threshold)
+        result = simulate_with(models, scene, end_time, settings, impact_threshold=impact_threshold,
+                               stop_at_rest=stop_at_rest)
         result.stop_reason = STOP_ENERGY_CHECK
         result.wall_time = _time.perf_counter() - t_start
         return result
@@ -590,6 +617,8 @@ def simulate_with(models: FreshModels, scene: Scene, end_time: float = 10.0,
     else:
         result.stop_reason = STOP_NO_BOUND if requested and not early_stop else STOP_END_TIME
         result.end_time = float(end_time)
+        if at_rest:
+            result.stop_reason, result.rest_time, result.rest_tolerance = STOP_AT_REST, rest.time, rest.tolerance
     result.requested_end_time = float(end_time)
     result.steps = steps
     t_end = _time.perf_counter()

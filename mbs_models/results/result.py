@@ -87,6 +87,12 @@ class Result:
     the named metrics were proven final (``stop_reason == "metrics_final"``, see
     :mod:`mbs_models.engine.final_metrics`).  ``final_metrics`` names the metrics whose values are those
     of a run to ``requested_end_time``; every other metric (with its time) is None -- ``impacts`` too.
+
+    At rest (``stop_reason == "at_rest"``, :mod:`mbs_models.engine.rest`): the solve stopped at ``rest_time`` (s),
+    from which on energy bounds prove every position within ``rest_tolerance`` (m) of the rest state and every
+    velocity within it (m/s); the histories are integrated up to ``rest_time`` and hold the rest state from
+    there (a sample at ``rest_time`` and one at ``end_time``, the requested end time; velocities, accelerations
+    0).  ``rest_time`` and ``rest_tolerance`` are None otherwise.
     """
 
     scene: Any
@@ -122,6 +128,8 @@ class Result:
     requested_end_time: float | None = None
     stop_reason: str = "end_time"
     final_metrics: tuple[str, ...] = ALL_METRICS
+    rest_time: float | None = None
+    rest_tolerance: float | None = None
 
     def __post_init__(self):
         if self.requested_end_time is None:
@@ -304,6 +312,7 @@ class Result:
             "dissipated_energy": dict(self.dissipated_energy),
             "energy": self.energy(),
             **self._firing_metrics(),
+            **self._rest_metrics(),
             "steps": self.steps,
             "wall_time": self.wall_time,
         }
@@ -322,10 +331,26 @@ class Result:
             out["work"] = {name: float(history[-1]) for name, history in self.work_histories.items()}
         return out
 
+    def _rest_metrics(self) -> dict[str, Any]:
+        """``rest_time`` (s) and ``rest_tolerance`` (m and m/s) of a run stopped at rest (only then)."""
+        if self.rest_time is None:
+            return {}
+        return {"rest_time": self.rest_time, "rest_tolerance": self.rest_tolerance}
+
+    def rest_note(self) -> str | None:
+        """One line saying when the run came to rest and what was proven (None if it did not stop at rest)."""
+        if self.rest_time is None:
+            return None
+        return (f"at rest from t = {self.rest_time:.6g} s (proven: every position within {self.rest_tolerance:g} m "
+                f"of its rest position and every velocity within {self.rest_tolerance:g} m/s from then on); the "
+                f"remaining {self.end_time - self.rest_time:.6g} s hold the rest state, not integrated")
+
     def summary(self) -> str:
         """A few human-readable lines."""
         window = f"{self.end_time:g} s"
-        if self.stop_reason != "end_time":
+        if self.rest_time is not None:
+            window += f" (at rest from {self.rest_time:.6g} s)"
+        elif self.stop_reason != "end_time":
             window += f" of {self.requested_end_time:g} s requested ({self.stop_reason.replace('_', ' ')})"
         name, label = self.scene.name, self.scene.model_label
         header = name if label.lower() in name.lower() else f"{name} ({label})"  # the model named once

@@ -163,3 +163,30 @@ def test_a_pulse_in_milliseconds_and_kilonewtons_warns_naming_its_times_and_forc
     assert times.startswith("recoil: warning: firing.pulse.times span 12 s")
     assert forces.startswith("recoil: warning: firing.pulse.forces peak at 2000 N")
     assert "$" not in captured.out + captured.err
+
+
+def test_a_run_at_rest_says_so_on_one_line_and_keeps_its_csv_small(tmp_path, capsys):
+    """Model (ii) to 1000 s rests after ~25 s: one stderr line with the rest time and the proven bound, the JSON's
+    ``stop_reason``, ``rest_time`` and ``rest_tolerance``, and a CSV whose rows do not grow with the end time."""
+    rows = {}
+    for end_time in ("200", "1000"):
+        target = tmp_path / f"run{end_time}.csv"
+        assert main(["run", "model_ii", "--end-time", end_time, "--json", "--csv", str(target)]) == 0
+        captured = capsys.readouterr()
+        data = json.loads(captured.out)
+        (line,) = captured.err.splitlines()
+        assert data["stop_reason"] == "at_rest" and data["end_time"] == float(end_time)
+        assert data["rest_tolerance"] == 1e-11 and 0.0 < data["rest_time"] < 100.0
+        assert line.startswith(f"recoil: at rest from t = {data['rest_time']:.6g} s (proven: every position within "
+                               "1e-11 m") and f"remaining {float(end_time) - data['rest_time']:.6g} s" in line
+        with target.open(newline="") as stream:
+            rows[end_time] = list(csv.reader(stream))
+        assert float(rows[end_time][-1][0]) == float(end_time)
+    assert len(rows["200"]) == len(rows["1000"])
+
+
+def test_no_stop_at_rest_integrates_to_the_end(capsys):
+    assert main(["run", "model_ii", "--end-time", "150", "--accuracy", "draft", "--json", "--no-stop-at-rest"]) == 0
+    captured = capsys.readouterr()
+    data = json.loads(captured.out)
+    assert data["stop_reason"] == "end_time" and "rest_time" not in data and captured.err == ""

@@ -36,3 +36,17 @@ def test_the_header_names_the_model_once_and_adds_it_where_the_name_lacks_it():
     assert simulate(scene, 0.05, "draft").summary().splitlines()[0].count("model (ii)") == 1
     renamed = scene.with_changes(name="my mechanism")
     assert simulate(renamed, 0.05, "draft").summary().splitlines()[0].startswith("my mechanism (model (ii)), ")
+
+
+def test_a_run_at_rest_says_when_in_its_summary_and_metrics():
+    """Stopped at rest: the header names the rest time, ``rest_note`` the proven bound, ``metrics()`` both; a run
+    that did not rest has neither."""
+    rested = simulate(simplified_model(), 200.0, "draft")
+    header = rested.summary().splitlines()[0]
+    assert f"200 s (at rest from {rested.rest_time:.6g} s)" in header
+    assert rested.metrics()["rest_time"] == rested.rest_time and rested.metrics()["rest_tolerance"] == 1e-8
+    assert rested.rest_note().startswith(f"at rest from t = {rested.rest_time:.6g} s (proven: every position within "
+                                         "1e-08 m of its rest position and every velocity within 1e-08 m/s")
+    assert not rested.maxima_at_end_of_window()
+    short = simulate(simplified_model(), 2.0, "draft")
+    assert short.rest_note() is None and "rest_time" not in short.metrics() and "at rest" not in short.summary()
