@@ -31,7 +31,6 @@ to write unless all are equal to the bit.
 from __future__ import annotations
 
 import argparse
-import hashlib
 import json
 import subprocess
 import sys
@@ -119,24 +118,13 @@ def record(result, accuracy: str) -> dict:
     return out
 
 
-def _digest(array) -> str | None:
-    if array is None:
-        return None
-    array = np.ascontiguousarray(np.asarray(array, dtype=float))
-    return f"{array.size}:" + hashlib.sha256(array.tobytes()).hexdigest()
-
-
 def first_format(result) -> dict:
     """The run as the first recording (a5f098b) kept it: float.hex, SHA-256 of every history."""
-    return _outputs(result, float.hex, _digest)
+    return _outputs(result, float.hex, recorded.digest)
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("out")
-    parser.add_argument("--tree", default=str(HERE), help="the checkout whose engine is recorded")
-    parser.add_argument("--verify", help="the first recording (float.hex and SHA-256) to check every run against")
-    args = parser.parse_args()
+    args = recorded.recorder_arguments(__doc__, HERE)
     tree = Path(args.tree).resolve()
     sys.path.insert(0, str(tree))
     import mbs_models

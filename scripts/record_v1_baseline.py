@@ -27,8 +27,6 @@ record thus holds the first recording's numbers, with the samples a tolerance ne
 
 from __future__ import annotations
 
-import argparse
-import hashlib
 import json
 import subprocess
 import sys
@@ -67,19 +65,27 @@ def _float(value):
     return None if value is None else float(value)
 
 
-def record(result, scene, accuracy: str) -> dict:
-    """One run as the record keeps it (floats exact in JSON, histories as summaries)."""
-    out = {name: _float(getattr(result, name)) for name in SCALARS}
-    out["arrays"] = {name: recorded.summary(getattr(result, name)) for name in ARRAYS}
-    out["dissipated_energy"] = {k: _float(v) for k, v in result.dissipated_energy.items()}
-    out["dissipated_energy_history"] = {k: recorded.summary(v) for k, v in result.dissipated_energy_history.items()}
+def _outputs(result, number, history) -> dict:
+    """The recorded outputs of a run, floats (or None) through ``number``, histories through ``history``."""
+    def value(x):
+        return None if x is None else number(float(x))
+    out = {name: value(getattr(result, name)) for name in SCALARS}
+    out["arrays"] = {name: history(getattr(result, name)) for name in ARRAYS}
+    out["dissipated_energy"] = {k: value(v) for k, v in result.dissipated_energy.items()}
+    out["dissipated_energy_history"] = {k: history(v) for k, v in result.dissipated_energy_history.items()}
     out["impacts"] = None if result.impacts is None else [
-        [float(i.start), float(i.end), float(i.peak_force), float(i.time_of_peak_force)] for i in result.impacts]
+        [value(i.start), value(i.end), value(i.peak_force), value(i.time_of_peak_force)] for i in result.impacts]
     out["steps"] = result.steps
     out["solver"] = result.settings.label()
-    out["max_step"] = _float(result.settings.max_step)
+    out["max_step"] = value(result.settings.max_step)
     out["stop_reason"] = result.stop_reason
     out["final_metrics"] = list(result.final_metrics)
+    return out
+
+
+def record(result, scene, accuracy: str) -> dict:
+    """One run as the record keeps it (floats exact in JSON, histories as summaries, the run's scales)."""
+    out = _outputs(result, float, recorded.summary)
     out["accuracy"] = accuracy
     mechanical = result.kinetic_energy_history + result.stored_energy_history
     out["scales"] = recorded.scales(
@@ -91,40 +97,13 @@ def record(result, scene, accuracy: str) -> dict:
     return out
 
 
-# ------------------------------------------------------------------ the first recording's format, to verify
-def _digest(array) -> str | None:
-    if array is None:
-        return None
-    array = np.ascontiguousarray(np.asarray(array, dtype=float))
-    return f"{array.size}:" + hashlib.sha256(array.tobytes()).hexdigest()
-
-
-def _hexed(value):
-    return None if value is None else float(value).hex()
-
-
 def first_format(result) -> dict:
     """The run as the first recording (cb32584) kept it: float.hex scalars, SHA-256 of every history."""
-    out = {name: _hexed(getattr(result, name)) for name in SCALARS}
-    out["arrays"] = {name: _digest(getattr(result, name)) for name in ARRAYS}
-    out["dissipated_energy"] = {k: _hexed(v) for k, v in result.dissipated_energy.items()}
-    out["dissipated_energy_history"] = {k: _digest(v) for k, v in result.dissipated_energy_history.items()}
-    out["impacts"] = None if result.impacts is None else [
-        [_hexed(i.start), _hexed(i.end), _hexed(i.peak_force), _hexed(i.time_of_peak_force)] for i in result.impacts]
-    out["steps"] = result.steps
-    out["solver"] = result.settings.label()
-    out["max_step"] = _hexed(result.settings.max_step)
-    out["stop_reason"] = result.stop_reason
-    out["final_metrics"] = list(result.final_metrics)
-    return out
+    return _outputs(result, float.hex, recorded.digest)
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("out")
-    parser.add_argument("--tree", default=str(HERE), help="the checkout whose engine is recorded")
-    parser.add_argument("--verify", help="the first recording (float.hex and SHA-256) to check every run against")
-    args = parser.parse_args()
+    args = recorded.recorder_arguments(__doc__, HERE)
     tree = Path(args.tree).resolve()
     sys.path[:0] = [str(tree), str(tree / "tests")]
     from mbs_models import model_i, model_ii, simplified_model, simulate

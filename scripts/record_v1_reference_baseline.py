@@ -13,7 +13,6 @@ recording (commit cb32584) to the bit and adds the machine's CPU kernels to it:
 """
 from __future__ import annotations
 
-import argparse
 import json
 import subprocess
 import sys
@@ -33,11 +32,7 @@ def _hexed(value):
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("out")
-    parser.add_argument("--tree", default=str(HERE), help="the checkout whose reference is recorded")
-    parser.add_argument("--verify", help="the first recording, to check every case against (to the bit)")
-    args = parser.parse_args()
+    args = recorded.recorder_arguments(__doc__, HERE)
     tree = Path(args.tree).resolve()
     sys.path.insert(0, str(tree))
     from mbs_models import model_i, model_ii, simplified_model

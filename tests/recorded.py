@@ -74,6 +74,29 @@ def sample_indices(size: int) -> np.ndarray:
     return np.unique(np.round(np.linspace(0, size - 1, min(size, SAMPLES))).astype(int))
 
 
+def digest(array) -> str | None:
+    """``"size:sha256"`` of an array's float64 bytes: how the first recordings kept a history (to verify against
+    them; never to compare across machines)."""
+    import hashlib
+
+    if array is None:
+        return None
+    array = np.ascontiguousarray(np.asarray(array, dtype=float))
+    return f"{array.size}:" + hashlib.sha256(array.tobytes()).hexdigest()
+
+
+def recorder_arguments(doc: str, here):
+    """The arguments of a recording script: ``out``, ``--tree`` (the checkout recorded, default ``here``) and
+    ``--verify`` (the first recording, checked to the bit)."""
+    import argparse
+
+    parser = argparse.ArgumentParser(description=doc.splitlines()[0])
+    parser.add_argument("out")
+    parser.add_argument("--tree", default=str(here), help="the checkout whose engine or reference is recorded")
+    parser.add_argument("--verify", help="the first recording, to check every run against to the bit")
+    return parser.parse_args()
+
+
 def scales(*, length, velocity, acceleration, force, energy) -> dict[str, float]:
     """A run's scales (each the largest magnitude of the arrays given, at least the smallest normal float):
     tolerances of lengths (m), velocities (m/s), accelerations (m/s^2), forces (N) and energies (J) are
