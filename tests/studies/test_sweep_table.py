@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import sys
 
+import numpy as np
 import pandas as pd
 import pytest
 
@@ -29,10 +30,9 @@ def test_types_are_fixed_by_the_column():
 
 @pytest.mark.parametrize("suffix", [".csv", ".parquet"])
 def test_round_trip_is_exact(tmp_path, suffix):
-    file = SweepFile(tmp_path / f"t{suffix}", PARAMS, METRICS, parquet_interval=0.0)
+    file = SweepFile(tmp_path / f"t{suffix}", PARAMS, METRICS)
     file.append(ROWS[:1])
     file.append(ROWS[1:])
-    file.flush()
     again = SweepFile(tmp_path / f"t{suffix}", PARAMS, METRICS).read()
     pd.testing.assert_frame_equal(again, frame(ROWS, PARAMS, METRICS))
     assert again["contact.gap"][1] == 1 / 3 and again["max_barrel_displacement"][0] == 0.1 + 0.2
@@ -75,14 +75,16 @@ def test_files_honour_the_umask(tmp_path, suffix, mask, mode):
 
     saved = os.umask(mask)
     try:
-        file = SweepFile(tmp_path / f"t{suffix}", PARAMS, METRICS, parquet_interval=0.0)
+        file = SweepFile(tmp_path / f"t{suffix}", PARAMS, METRICS)
         file.write_settings({"end_time": 10.0})
         file.append(ROWS[:1])
+        file.finish(lambda chunk: np.zeros(len(chunk), dtype=np.int64))
+        file.append(ROWS[1:])
         file.write_all(frame(ROWS, PARAMS, METRICS))
-        file.flush()
+        file.finish(lambda chunk: np.arange(len(chunk), dtype=np.int64))
     finally:
         os.umask(saved)
-    assert len(list(tmp_path.iterdir())) == 2  # the table and its settings, no temporary file
+    assert len(list(tmp_path.iterdir())) == 2  # the table and its settings, no temporary file or journal
     for path in tmp_path.iterdir():
         assert stat.S_IMODE(path.stat().st_mode) == mode, path.name
 
