@@ -10,9 +10,11 @@ to the largest held), and at the end the file is put in grid order by an externa
 bit; the table itself is in memory only when it is returned (``table=True``, the default) or when there is
 no file (``out=None``).
 
-Before the points run, one line says how many there are and roughly how long they will take: the first
-point runs alone (its row is kept) and its solve's wall time, times the points to run, over the workers,
-is the estimate (:func:`announcement`).
+Before the points run, one line says how many there are and roughly how long they will take: a few
+points spread over the grid run first (:func:`probe_indices`; their rows are kept), and the mean of their
+solves' wall times, times the points to run, over the workers, is the estimate (:func:`announcement`) --
+points differ (a light absorber can take five times the steps of a heavy one), so the first point alone
+would not do.
 """
 
 from __future__ import annotations
@@ -29,8 +31,8 @@ from ..scene import Scene
 
 #: Failed points a summary lists (``table=False``; ``recoil sweep --json``): the first ones in grid order.
 SUMMARY_FAILURES = 1000
-#: Points run alone, one after the other, to time a solve before the others start (until one solves).
-PROBE_POINTS = 3
+#: Points spread over the grid that run first, to time a solve before the others start.
+PROBE_POINTS = 4
 
 
 def run_sweep(scene: Scene, params, *, end_time: float = 10.0, accuracy: str | SolverSettings = "standard",
@@ -122,13 +124,14 @@ def run_sweep(scene: Scene, params, *, end_time: float = 10.0, accuracy: str | S
         size = batch_size or _backends.batch_size(pending, backend.workers)
         bar = None
         try:
-            missing = sink.done.missing(grid.size)
-            probed, seconds = _probe(backend, scene, settings, grid, missing, sink)
+            probed = probe_indices(sink.done, grid, min(PROBE_POINTS, math.ceil(pending / 10)))
+            seconds = _probe(backend, scene, settings, grid, probed, sink)
             if say is not None:
-                say(announcement(grid, sink.resumed, pending, backend.workers, seconds, probed,
+                say(announcement(grid, sink.resumed, pending, backend.workers, seconds, len(probed),
                                  where=None if out is None else str(out)))
             bar = _progress_bar(progress, grid.size, sink.resumed)
-            bar(probed)
+            bar(len(probed))
+            missing = (index for index in sink.done.missing(grid.size) if index not in probed)
             for batch in backend.run(evaluate_batch, _tasks(scene, settings, grid, missing, size)):
                 sink.add(batch)
                 bar(len(batch))
@@ -164,22 +167,32 @@ def _tasks(scene: Scene, settings, grid, missing: Iterator[int], size: int) -> I
         yield scene, settings, batch
 
 
-def _probe(backend, scene: Scene, settings, grid, missing: Iterator[int], sink) -> tuple[int, float | None]:
-    """Run the first points of ``missing`` alone, one at a time, until one solves (at most
-    :data:`PROBE_POINTS`); their rows go to ``sink``.  Returns (points run, that solve's wall time in s or None)."""
+def probe_indices(done, grid, count: int) -> list[int]:
+    """``count`` points of ``grid`` not in ``done``, spread over every key at once: the j-th takes the value at
+    ``(j + 1/2) / count`` of each key's range (a diagonal of the grid: evenly spaced indices would hit the
+    same value of the last key every time), or the first missing point after it."""
+    picks: list[int] = []
+    for j in range(count):
+        start = sum(((2 * j + 1) * n // (2 * count)) * stride for n, stride in zip(grid.shape, grid.strides))
+        index = next(done.missing(grid.size, start=start), None)
+        if index is None:
+            index = next(done.missing(grid.size), None)
+        if index is not None and index not in picks:
+            picks.append(index)
+    return picks
+
+
+def _probe(backend, scene: Scene, settings, grid, indices: Sequence[int], sink) -> float | None:
+    """Run the points ``indices`` (one per task, together) into ``sink``; the mean wall time (s) of their
+    solves, None if none solved."""
     from .point import evaluate_batch
 
-    for count in range(1, PROBE_POINTS + 1):
-        index = next(missing, None)
-        if index is None:
-            return count - 1, None
-        row = None
-        for batch in backend.run(evaluate_batch, [(scene, settings, [(index, grid.point(index))])]):
-            sink.add(batch)
-            row = batch[0][1]
-        if row is not None and row["status"] == "ok":
-            return count, float(row["wall_time"])
-    return PROBE_POINTS, None
+    times = []
+    tasks = [(scene, settings, [(index, grid.point(index))]) for index in indices]
+    for batch in backend.run(evaluate_batch, tasks):
+        sink.add(batch)
+        times += [row["wall_time"] for _, row in batch if row["status"] == "ok"]
+    return sum(times) / len(times) if times else None
 
 
 # ================================================================================================ the line
@@ -208,8 +221,8 @@ def _per_point_text(seconds: float) -> str:
 def announcement(grid, resumed: int, pending: int, workers: int, seconds: float | None, probed: int,
                  where: str | None = None) -> str:
     """The line a sweep starts with: how many points (the grid's shape), how many the file already holds,
-    and about how long the others take -- ``seconds`` (the first point's solve, measured) x ``pending`` /
-    ``workers``, labelled an estimate; or why there is none."""
+    and about how long the others take -- ``seconds`` (the mean solve of the ``probed`` points, measured) x
+    ``pending`` / ``workers``, labelled an estimate; or why there is none."""
     from .grid import shape_text
 
     count = f"{grid.size:,} point{'s' if grid.size != 1 else ''} ({shape_text(grid.shape)})"
@@ -218,12 +231,13 @@ def announcement(grid, resumed: int, pending: int, workers: int, seconds: float 
         return f"sweep: {count}{held}: nothing to run"
     workers_text = f"{workers} worker{'s' if workers != 1 else ''}"
     others = f" for the {pending:,} to run" if resumed else ""
+    sample = "one point's solve" if probed == 1 else f"the mean solve of {probed} points"
     if seconds is None:
-        return (f"sweep: {count}{held}; {pending:,} to run on {workers_text}; no time estimate: the first "
-                f"{probed} point{'s' if probed != 1 else ''} failed")
+        return (f"sweep: {count}{held}; {pending:,} to run on {workers_text}; no time estimate: "
+                f"{'the point' if probed == 1 else f'all {probed} points'} tried failed")
     total = seconds * pending / workers
     return (f"sweep: {count}{held}, ~{_per_point_text(seconds)} per point on {workers_text}: about "
-            f"{duration_text(total)}{others} (an estimate from the first point's solve)")
+            f"{duration_text(total)}{others} (an estimate from {sample})")
 
 
 def _announcer(announce, progress) -> Callable[[str], None] | None:
@@ -398,4 +412,4 @@ def _progress_bar(progress, total: int, initial: int) -> _Bar:
                 total=total, initial=initial)
 
 
-__all__ = ["run_sweep", "announcement", "duration_text", "SUMMARY_FAILURES", "PROBE_POINTS"]
+__all__ = ["run_sweep", "announcement", "probe_indices", "duration_text", "SUMMARY_FAILURES", "PROBE_POINTS"]
