@@ -243,7 +243,8 @@ class SweepFile:
             try:
                 raws = self._csv_chunks(path) if fmt == "csv" else self._parquet_chunks(path)
                 for raw in raws:
-                    yield typed(raw, self.params, self.metrics, self.kinds)
+                    if len(raw):   # a file of its header alone (a run killed before its first row) gives nothing
+                        yield typed(raw, self.params, self.metrics, self.kinds)
             except (OSError, ValueError, KeyError) as exc:
                 if isinstance(exc, SceneError):
                     raise

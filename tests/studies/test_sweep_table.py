@@ -179,3 +179,15 @@ def test_a_cut_line_is_found_from_the_end(tmp_path):
     path.write_bytes(b"a,")                            # the header itself cut short
     drop_cut_line(path, block=1)
     assert path.read_bytes() == b""
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".parquet"])
+def test_a_file_of_its_header_alone_has_no_rows(tmp_path, suffix):
+    kinds = {"contact.gap": "float", "contact.law": "text"}
+    path = tmp_path / f"t{suffix}"
+    empty = frame([], PARAMS, METRICS, kinds)
+    empty.to_csv(path, index=False) if suffix == ".csv" else empty.to_parquet(path, index=False)
+    file = SweepFile(path, PARAMS, METRICS, kinds=kinds)
+    assert list(file.chunks()) == []
+    file.append(ROWS)
+    pd.testing.assert_frame_equal(file.read(), frame(ROWS, PARAMS, METRICS, kinds))
