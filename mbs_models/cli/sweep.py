@@ -2,13 +2,13 @@
 
     recoil sweep model_i --param absorber.mass=100,500,1000 --param contact.gap=0:0.12:13 --out gaps.csv
 
-Bad keys, specs, values and paths exit 2 with one line naming them, before anything is written, and so
-does a grid of more than 10^6 points without ``--large``; a failing point is a row of the table
-(``status``, ``error``) and the sweep goes on; running the same command again resumes (only the points not
-yet in the file run).  Before the points run, one line on stderr says how many there are and about how
-long they take (measured on the first point: an estimate).  The table stays in its file: memory does not
-grow with the grid.  ``--set KEY=VALUE`` (``recoil run``,
-``recoil validate``) changes fields of the scene for one run, with the same keys.
+Bad keys, specs, values and paths exit 2 with one line naming them, before anything is written, and so does
+a grid of more than 10^6 points without ``--large``; a failing point is a row of the table (``status``,
+``error``) and the sweep goes on; running the same command again resumes (only the points not yet in the
+file run). Before the points run, one line on stderr says how many there are and about how long they take
+(measured on a few points spread over the grid: an estimate). The table stays in its file: memory does not
+grow with the grid. ``--set KEY=VALUE`` (``recoil run``, ``recoil validate``) changes fields of the scene
+for one run, with the same keys.
 """
 
 from __future__ import annotations
