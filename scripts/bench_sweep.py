@@ -47,7 +47,7 @@ def main(argv=None) -> int:
     scene = _resolve_scene(args.scene)
     params = {"absorber.mass": args.masses, "contact.gap": f"0:0.12:{args.gaps}"}
     from mbs_models.studies.grid import make_grid
-    points = make_grid(scene, params).points()
+    points = list(make_grid(scene, params).points())
     print(f"{len(points)} points of {args.scene}, {args.end_time:g} s each, pool of {args.workers}; "
           f"{args.repeats} alternating rounds, medians")
 

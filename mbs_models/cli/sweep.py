@@ -2,10 +2,13 @@
 
     recoil sweep model_i --param absorber.mass=100,500,1000 --param contact.gap=0:0.12:13 --out gaps.csv
 
-Bad keys, specs, values and paths exit 2 with one line naming them, before anything is written; a
-failing point is a row of the table (``status``, ``error``) and the sweep goes on; running the same
-command again resumes (only the points not yet in the file run).  ``--set KEY=VALUE`` (``recoil run``,
-``recoil validate``) changes fields of the scene for one run, with the same keys.
+Bad keys, specs, values and paths exit 2 with one line naming them, before anything is written, and so does
+a grid of more than 10^6 points without ``--large``; a failing point is a row of the table (``status``,
+``error``) and the sweep goes on; running the same command again resumes (only the points not yet in the
+file run). Before the points run, one line on stderr says how many there are and about how long they take
+(measured on a few points spread over the grid: an estimate). The table stays in its file: memory does not
+grow with the grid. ``--set KEY=VALUE`` (``recoil run``, ``recoil validate``) changes fields of the scene
+for one run, with the same keys.
 """
 
 from __future__ import annotations
@@ -15,6 +18,7 @@ import sys
 import time
 
 from ..errors import SceneError
+from ..studies.grid import MAX_POINTS
 
 #: run_sweep's argument names -> the options that give them.
 _OPTIONS = {"out": "--out", "scheduler": "--scheduler", "workers": "--workers", "end_time": "--end-time",
@@ -64,6 +68,9 @@ def add_sweep_parser(sub) -> None:
                        help="run on a Dask cluster: the scheduler's tcp://HOST:PORT (needs the cluster extra)")
     sweep.add_argument("--accuracy", default="standard", choices=("draft", "standard", "reference"))
     sweep.add_argument("--end-time", type=float, default=10.0, help="simulated time in s (default 10)")
+    sweep.add_argument("--large", action="store_true",
+                       help=f"run a grid of more than {MAX_POINTS:,} points (refused without it: hours to days of "
+                            "CPU and a table of gigabytes are rarely meant)")
     sweep.add_argument("--json", action="store_true", help="print the summary as JSON (no progress bar)")
     sweep.set_defaults(handler=run_command)
 
@@ -71,6 +78,7 @@ def add_sweep_parser(sub) -> None:
 def run_command(args) -> int:
     """The ``recoil sweep`` handler: exit 0 once every point has a row (failed points included)."""
     from ..scene.overrides import parse_assignment
+    from ..studies.grid import GridTooLarge
     from ..studies.sweep import run_sweep
     from . import EXIT_OK, _resolve_scene
 
@@ -83,26 +91,28 @@ def run_command(args) -> int:
         params[key] = spec
     start = time.perf_counter()
     try:
-        table = run_sweep(scene, params, end_time=args.end_time, accuracy=args.accuracy, workers=args.workers,
-                          scheduler=args.scheduler, out=args.out, progress=not args.json)
+        summary = run_sweep(scene, params, end_time=args.end_time, accuracy=args.accuracy, workers=args.workers,
+                            scheduler=args.scheduler, out=args.out, progress=not args.json, large=args.large,
+                            table=False, announce=lambda line: print(line, file=sys.stderr, flush=True))
+    except GridTooLarge as exc:
+        raise exc.with_flag("--large", "--large") from None
     except SceneError as exc:
         raise SceneError(_OPTIONS.get(exc.key, exc.key), exc.message) from None
     except KeyboardInterrupt:
         print(f"recoil sweep: interrupted; the finished points are in {args.out}: run the same command again "
               "to resume", file=sys.stderr)
         raise
-    summary = dict(table.attrs["sweep"], wall_time=time.perf_counter() - start)
-    failed = table[table["status"] != "ok"]
-    if args.json:
-        summary["failures"] = [{**{key: row[key] for key in params}, "status": row["status"], "error": row["error"]}
-                               for row in failed.to_dict("records")]
+    failures = summary.pop("failures")
+    summary["wall_time"] = time.perf_counter() - start
+    if args.json:   # the first SUMMARY_FAILURES failed points (all of them are in the table)
+        summary["failures"] = failures
         print(json.dumps(summary, indent=2, allow_nan=False, default=float))
     else:
         print(f"{summary['points']} points: {summary['run']} run, {summary['resumed']} resumed from the file, "
               f"{summary['failed']} failed; table in {summary['out']} ({summary['wall_time']:.1f} s)")
-        for row in failed.head(5).to_dict("records"):
+        for row in failures[:5]:
             where = ", ".join(f"{key}={row[key]}" for key in params)
             print(f"  failed at {where}: {row['status']}: {row['error']}")
-        if len(failed) > 5:
-            print(f"  ... and {len(failed) - 5} more (column 'error' of the table)")
+        if summary["failed"] > 5:
+            print(f"  ... and {summary['failed'] - 5} more (column 'error' of the table)")
     return EXIT_OK

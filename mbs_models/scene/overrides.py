@@ -262,38 +262,58 @@ def _shortest(value: float) -> float:
     return value
 
 
-def parse_spec(spec: str, key: str = "") -> list[Any]:
-    """The values of a sweep parameter: ``"100,500,1000"`` (a list of TOML values), ``"0:0.12:13"``
-    (``START:STOP:COUNT``: COUNT evenly spaced numbers, both ends included exactly, each point the shortest
-    decimal within 4 ulp of ``START + i (STOP - START) / (COUNT - 1)``: no round-off noise) or ``"[...]"`` (a
-    TOML array, whose items may themselves be lists).  ``key`` names the parameter in errors."""
+def _spec_text(spec: str, key: str) -> str:
     if not isinstance(spec, str):
         raise SceneError(key, f"must be a text spec (100,500,1000 or START:STOP:COUNT), got {spec!r}")
     text = spec.strip()
     if not text:
         raise SceneError(key, "no values given (use 100,500,1000 or START:STOP:COUNT)")
+    return text
+
+
+def _range(text: str, key: str) -> tuple[float, float, int]:
+    """``START:STOP:COUNT`` read and checked: (start, stop, count)."""
+    parts = [p.strip() for p in text.split(":")]
+    if len(parts) != 3:
+        raise SceneError(key, f"a range is START:STOP:COUNT (e.g. 0:0.12:13), got {text!r}")
+    try:
+        start, stop = float(parts[0]), float(parts[1])
+    except ValueError:
+        raise SceneError(key, f"START and STOP of {text!r} must be numbers") from None
+    if not (math.isfinite(start) and math.isfinite(stop)):
+        raise SceneError(key, f"START and STOP of {text!r} must be finite numbers")
+    try:
+        count = int(parts[2])
+    except ValueError:
+        raise SceneError(key, f"COUNT of {text!r} must be a whole number >= 2, got {parts[2]!r}") from None
+    if count < 2:
+        raise SceneError(key, f"COUNT of {text!r} must be a whole number >= 2 (both ends are included), "
+                              f"got {count}")
+    return start, stop, count
+
+
+def spec_size(spec: str, key: str = "") -> int:
+    """How many values :func:`parse_spec` gives ``spec``, without making them (a range's COUNT is read, not
+    generated: a grid's size is known before a ``0:1:10000000000`` fills the memory)."""
+    text = _spec_text(spec, key)
+    if not text.startswith("[") and ":" in text:
+        return _range(text, key)[2]
+    return len(parse_spec(text, key))
+
+
+def parse_spec(spec: str, key: str = "") -> list[Any]:
+    """The values of a sweep parameter: ``"100,500,1000"`` (a list of TOML values), ``"0:0.12:13"``
+    (``START:STOP:COUNT``: COUNT evenly spaced numbers, both ends included exactly, each point the shortest
+    decimal within 4 ulp of ``START + i (STOP - START) / (COUNT - 1)``: no round-off noise) or ``"[...]"`` (a
+    TOML array, whose items may themselves be lists).  ``key`` names the parameter in errors."""
+    text = _spec_text(spec, key)
     if text.startswith("["):
         values = parse_value(text, key)
         if not isinstance(values, list) or not values:
             raise SceneError(key, f"must be a non-empty TOML array, got {text!r}")
         return values
     if ":" in text:
-        parts = [p.strip() for p in text.split(":")]
-        if len(parts) != 3:
-            raise SceneError(key, f"a range is START:STOP:COUNT (e.g. 0:0.12:13), got {text!r}")
-        try:
-            start, stop = float(parts[0]), float(parts[1])
-        except ValueError:
-            raise SceneError(key, f"START and STOP of {text!r} must be numbers") from None
-        if not (math.isfinite(start) and math.isfinite(stop)):
-            raise SceneError(key, f"START and STOP of {text!r} must be finite numbers")
-        try:
-            count = int(parts[2])
-        except ValueError:
-            raise SceneError(key, f"COUNT of {text!r} must be a whole number >= 2, got {parts[2]!r}") from None
-        if count < 2:
-            raise SceneError(key, f"COUNT of {text!r} must be a whole number >= 2 (both ends are included), "
-                                  f"got {count}")
+        start, stop, count = _range(text, key)
         step = (stop - start) / (count - 1)
         return [start] + [_shortest(start + i * step) for i in range(1, count - 1)] + [stop]
     items = [item.strip() for item in text.split(",")]
@@ -302,4 +322,5 @@ def parse_spec(spec: str, key: str = "") -> list[Any]:
     return [parse_value(item, key) for item in items]
 
 
-__all__ = ["apply_overrides", "check_keys", "resolve_key", "parse_value", "parse_spec", "parse_assignment"]
+__all__ = ["apply_overrides", "check_keys", "resolve_key", "parse_value", "parse_spec", "spec_size",
+           "parse_assignment"]

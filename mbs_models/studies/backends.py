@@ -2,10 +2,15 @@
 
 Every backend runs a module-level ``function`` over picklable ``tasks`` and yields the results **as they
 finish** (any order: the caller orders them), so that a sweep can write each row as soon as it exists.
+``tasks`` may be any iterable -- a generator over a grid of 10^8 points -- and is read lazily: at most
+``in_flight`` tasks (default :func:`in_flight`: four per worker) are handed out and not yet returned, the
+next one taken as one finishes, so that what a run holds does not depend on how many tasks there are.
 
 * ``serial`` (:class:`SerialBackend`): in this process, in order.
 * ``processes`` (:class:`ProcessBackend`): a local pool of worker processes (default: every CPU this
-  process may use); each worker builds its own models (Exudyn models cannot be pickled).
+  process may use); each worker builds its own models (Exudyn models cannot be pickled).  The pool is
+  kept from one completed ``run`` to the next (its workers keep their models) until :meth:`close`; a run
+  that ends early (an error, an interrupt, a caller that stops reading) shuts it down.
 * ``dask`` (:class:`DaskBackend`): the workers of a Dask distributed cluster, given as a scheduler address
   ``tcp://HOST:PORT`` or a ``dask.distributed.Client``.  The scheduler re-runs the tasks of a worker that
   dies.  Dask is imported only here, and only then (the ``cluster`` extra: ``pip install recoil-mbs[cluster]``).
@@ -15,13 +20,14 @@ finish** (any order: the caller orders them), so that a sweep can write each row
 
 from __future__ import annotations
 
+import itertools
 import math
 import multiprocessing
 import os
 import time
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
-from typing import Any, Callable, Iterator, Sequence
+from typing import Any, Callable, Iterable, Iterator
 
 from ..errors import SceneError, SimulationError
 
@@ -48,6 +54,19 @@ def batch_size(points: int, workers: int, *, per_worker: int = 4, largest: int =
     return max(1, min(largest, math.ceil(points / (per_worker * max(1, workers)))))
 
 
+def in_flight(workers: int, per_worker: int = 4) -> int:
+    """Tasks a backend hands out at once: ``per_worker`` per worker (every worker busy, one task queued behind
+    each, a few spare for the Dask scheduler to balance)."""
+    return per_worker * max(1, workers)
+
+
+def _check_in_flight(limit: int | None, workers: int) -> int:
+    limit = in_flight(workers) if limit is None else limit
+    if isinstance(limit, bool) or not isinstance(limit, int) or limit < 1:
+        raise SceneError("in_flight", f"must be a whole number >= 1, got {limit!r}")
+    return limit
+
+
 def exit_with_parent(parent: int, period: float = 1.0) -> None:
     """In a pool's worker: a daemon thread that ends this process once ``parent`` is gone (a parent killed
     with SIGKILL leaves its pool's workers waiting for tasks forever otherwise)."""
@@ -71,12 +90,12 @@ def local_pool(workers: int) -> ProcessPoolExecutor:
 
 
 class SerialBackend:
-    """Runs every task in this process, in order."""
+    """Runs every task in this process, in order (one at a time: nothing is held ahead)."""
 
     name = "serial"
     workers = 1
 
-    def run(self, function: Callable, tasks: Sequence) -> Iterator[Any]:
+    def run(self, function: Callable, tasks: Iterable, *, in_flight: int | None = None) -> Iterator[Any]:
         for task in tasks:
             yield function(task)
 
@@ -91,26 +110,45 @@ class SerialBackend:
 
 
 class ProcessBackend(SerialBackend):
-    """A local pool of ``workers`` processes (fork where available, else spawn)."""
+    """A local pool of ``workers`` processes (fork where available, else spawn), kept between runs."""
 
     name = "processes"
 
     def __init__(self, workers: int | None = None):
         self.workers = check_workers(workers)
+        self._pool: ProcessPoolExecutor | None = None
 
-    def run(self, function: Callable, tasks: Sequence) -> Iterator[Any]:
-        tasks = list(tasks)
-        if not tasks:
+    def run(self, function: Callable, tasks: Iterable, *, in_flight: int | None = None) -> Iterator[Any]:
+        limit = _check_in_flight(in_flight, self.workers)
+        tasks = iter(tasks)
+        first = list(itertools.islice(tasks, limit))
+        if not first:
             return
-        pool = local_pool(min(self.workers, len(tasks)))
+        if self._pool is None:
+            self._pool = local_pool(self.workers)
+        pool, finished = self._pool, False
         try:
-            futures = [pool.submit(function, task) for task in tasks]
-            for future in as_completed(futures):
-                yield future.result()
+            running = {pool.submit(function, task) for task in first}
+            del first
+            while running:
+                done, running = wait(running, return_when=FIRST_COMPLETED)
+                for future in done:
+                    result = future.result()
+                    for task in itertools.islice(tasks, 1):
+                        running.add(pool.submit(function, task))
+                    yield result
+            finished = True
         except BrokenProcessPool:
             raise SimulationError("a worker process died (killed, or out of memory); the points it had not "
                                   "finished are not in the table: run the same sweep again to resume") from None
         finally:
+            if not finished:   # an error, an interrupt or a caller that stopped reading: no work left behind
+                self._pool = None
+                pool.shutdown(wait=True, cancel_futures=True)
+
+    def close(self) -> None:
+        if self._pool is not None:
+            pool, self._pool = self._pool, None
             pool.shutdown(wait=True, cancel_futures=True)
 
 
@@ -137,17 +175,27 @@ class DaskBackend(SerialBackend):
                                           f"got {scheduler!r}")
         self.workers = max(1, len(self.client.scheduler_info().get("workers", {})))
 
-    def run(self, function: Callable, tasks: Sequence) -> Iterator[Any]:
+    def run(self, function: Callable, tasks: Iterable, *, in_flight: int | None = None) -> Iterator[Any]:
         distributed = import_distributed()
-        tasks = list(tasks)
-        if not tasks:
+        limit = _check_in_flight(in_flight, self.workers)
+        tasks = iter(tasks)
+        first = list(itertools.islice(tasks, limit))
+        if not first:
             return
-        futures = self.client.map(function, tasks, pure=False)
+        running = {self.client.submit(function, task, pure=False) for task in first}
+        del first
+        finished = distributed.as_completed(list(running), loop=self.client.loop)
         try:
-            for future in distributed.as_completed(futures, loop=self.client.loop):
-                yield future.result()
+            for future in finished:
+                running.discard(future)
+                result = future.result()
+                for task in itertools.islice(tasks, 1):
+                    new = self.client.submit(function, task, pure=False)
+                    running.add(new)
+                    finished.add(new)
+                yield result
         finally:
-            self.client.cancel([f for f in futures if not f.done()])
+            self.client.cancel([f for f in running if not f.done()])
 
     def close(self) -> None:
         if self._own:
@@ -170,7 +218,8 @@ BACKENDS = {"serial": SerialBackend, "processes": ProcessBackend, "dask": DaskBa
 
 def make_backend(workers: int | None = None, scheduler: Any = None):
     """The backend for these arguments: ``scheduler`` (an address or a Client) -> Dask; else ``workers == 1``
-    -> serial; else a local process pool of ``workers`` (default: every CPU).  Both given is an error."""
+    -> serial; else a local process pool of ``workers`` (default: every CPU).  Both given is an error.
+    Use it as a context manager (``with make_backend(...) as backend``): a pool is kept until it closes."""
     if scheduler is not None:
         if workers is not None:
             raise SceneError("workers", "give either workers (a local pool) or a scheduler (a Dask cluster), "
@@ -180,5 +229,5 @@ def make_backend(workers: int | None = None, scheduler: Any = None):
     return SerialBackend() if workers == 1 else ProcessBackend(workers)
 
 
-__all__ = ["BACKENDS", "SerialBackend", "ProcessBackend", "DaskBackend", "make_backend", "batch_size",
+__all__ = ["BACKENDS", "SerialBackend", "ProcessBackend", "DaskBackend", "make_backend", "batch_size", "in_flight",
            "default_workers", "check_workers", "import_distributed", "exit_with_parent", "local_pool"]

@@ -1,10 +1,12 @@
 """Parameter sweeps: a grid over dotted scene keys as one table, or a list of scenes; in parallel.
 
-* :func:`run_sweep` (public as ``mbs_models.run_sweep``, ``recoil sweep`` on the command line): the full
-  grid of values of dotted scene keys over one scene, one tidy row per point (a pandas DataFrame), written
-  to CSV/Parquet as rows finish and resumable; on a local process pool or a Dask cluster.  Its parts:
-  :mod:`.grid` (the points), :mod:`.point` (one point as a row; the one call of ``simulate``),
-  :mod:`.backends` (where points run), :mod:`.sweep_table` (the table's types and file).
+* :func:`run_sweep` (:mod:`.grid_sweep`; public as ``mbs_models.run_sweep``, ``recoil sweep`` on the
+  command line): the full grid of values of dotted scene keys over one scene, one tidy row per point (a
+  pandas DataFrame), written to CSV/Parquet as rows finish and resumable, streamed (memory independent of
+  the grid's size); on a local process pool or a Dask cluster.  Its parts: :mod:`.grid` (the points),
+  :mod:`.point` (one point as a row; the one call of ``simulate``), :mod:`.backends` (where points run),
+  :mod:`.point_set` (the points a file holds), :mod:`.sweep_table` (the table's types and file),
+  :mod:`.table_sort` (the file put in grid order).
 * :func:`run_scenes`, :func:`gap_sweep`, :func:`parallel_map`: many scenes (or any function) in worker
   processes, giving :class:`SweepPoint` objects (the validation studies use these).
 
@@ -188,150 +190,4 @@ def gap_sweep(factory: Callable[..., Scene], absorber_mass: float, gaps: Iterabl
 
 
 # ================================================================================================ grid sweeps
-def run_sweep(scene: Scene, params, *, end_time: float = 10.0, accuracy: str | SolverSettings = "standard",
-              workers: int | None = None, scheduler=None, out=None, progress=True,
-              stop_when_final: Sequence[str] = (), impact_threshold: float = 1000.0,
-              batch_size: int | None = None):
-    """Simulate ``scene`` at every point of the grid of ``params`` and return the table (a pandas DataFrame).
-
-    ``params``: dotted scene key -> values (a sequence, or a text spec ``"100,500,1000"`` /
-    ``"0:0.12:13"``: START:STOP:COUNT, both ends included), e.g. ``{"absorber.mass": [100, 500, 1000],
-    "contact.gap": "0:0.12:13"}``; the full grid runs (the first key varies slowest).  One row per point,
-    in grid order: the parameters (a column per key), every scalar metric
-    (:func:`~mbs_models.studies.point.metric_columns`), ``wall_time`` (s), ``status`` (``"ok"`` or the
-    error's class) and ``error`` (the message).  A point whose combination of values is invalid
-    (SceneError) or whose solve fails (SimulationError) is a row with its error; the sweep goes on.
-
-    ``workers``: a local process pool of that many processes (default: every CPU; 1 runs here);
-    ``scheduler``: a Dask scheduler address ``"tcp://HOST:PORT"`` or a ``dask.distributed.Client``
-    instead (the ``cluster`` extra).  Results are identical whichever runs them.
-
-    ``out``: a ``.csv`` (or, with pyarrow, ``.parquet``) file; rows are written as they finish and, at
-    the end, the file holds the table in grid order.  If ``out`` already holds rows of the same sweep, only
-    the points not yet in it run (a killed sweep resumes; the resumed table equals an uninterrupted one
-    but for ``wall_time``); ``FILE.sweep.json`` beside it records the scene and settings, and a file
-    computed with others is refused.  ``progress``: a tqdm bar on a terminal (rate, ETA), False for none, or a
-    callable ``progress(done, total)``.  ``end_time``, ``accuracy``, ``stop_when_final`` and
-    ``impact_threshold`` are those of :func:`~mbs_models.simulate`; ``batch_size``: points per task
-    (default: about four tasks per worker, at most 16 points each).
-
-    The returned table's ``attrs["sweep"]`` holds ``points``, ``resumed`` (rows taken from ``out``),
-    ``run``, ``failed`` and ``out``.  Bad keys, specs, values no point accepts, arguments or files raise
-    :class:`SceneError` before anything is written.
-    """
-    from ..engine.accuracy import solver_settings_for
-    from ..engine.final_metrics import check_metric_names
-    from ..engine.simulation import _check_arguments
-    from ..engine.unit_slips import warn_unit_slips
-    from . import backends as _backends
-    from .grid import make_grid
-    from .point import PointSettings, evaluate_batch, metric_columns
-    from .sweep_table import SweepFile, frame
-
-    if not isinstance(scene, Scene):
-        raise SceneError("scene", f"must be a Scene, got {type(scene).__name__}")
-    _check_arguments(scene, end_time, impact_threshold)
-    solver_settings_for(accuracy)
-    settings = PointSettings(float(end_time), accuracy, check_metric_names(stop_when_final), float(impact_threshold))
-    grid = make_grid(scene, params)
-    warn_unit_slips(scene, grid=dict(zip(grid.keys, grid.values)))  # to the caller of run_sweep
-    if batch_size is not None and (isinstance(batch_size, bool) or not isinstance(batch_size, int) or batch_size < 1):
-        raise SceneError("batch_size", f"must be a whole number >= 1, got {batch_size!r}")
-    if scheduler is None:
-        _backends.check_workers(workers)
-    elif workers is not None:
-        _backends.make_backend(workers, scheduler)  # the error: not both
-    params_columns, metrics = list(grid.keys), metric_columns(scene)
-    labels = grid.labels()
-    points = grid.points()
-    file = SweepFile(out, params_columns, metrics) if out is not None else None
-    if file is not None:
-        recorded = _settings_record(scene, settings)
-        file.check_settings(recorded)
-    done = _rows_in_file(file, labels) if file is not None else {}
-    pending = [(i, point) for i, (point, label) in enumerate(zip(points, labels)) if label not in done]
-    backend = _backends.make_backend(workers, scheduler) if pending else _backends.SerialBackend()
-    if file is not None:
-        file.write_settings(recorded)
-    with backend:
-        size = batch_size or _backends.batch_size(len(pending), backend.workers)
-        tasks = [(scene, settings, pending[i:i + size]) for i in range(0, len(pending), size)]
-        new: dict[int, dict] = {}
-        bar = _progress_bar(progress, len(points), len(done))
-        try:
-            for batch in backend.run(evaluate_batch, tasks):
-                rows = []
-                for index, row in batch:
-                    row.update(zip(params_columns, labels[index]))  # the values as table cells (lists as TOML)
-                    new[index] = row
-                    rows.append(row)
-                if file is not None:
-                    file.append(rows)
-                bar(len(batch))
-        finally:
-            bar.close()
-            if file is not None:
-                file.flush()
-    rows = [new[i] if i in new else done[label] for i, label in enumerate(labels)]
-    table = frame(rows, params_columns, metrics)
-    if file is not None:
-        file.write_all(table)
-    table.attrs["sweep"] = {"points": len(points), "resumed": len(points) - len(new), "run": len(new),
-                            "failed": int((table["status"] != "ok").sum()),
-                            "out": None if file is None else str(file.path)}
-    return table
-
-
-def _settings_record(scene: Scene, settings) -> dict:
-    """What every row of a sweep's file is computed with: the scene (its TOML text) and the point settings."""
-    from ..scene.io import scene_to_toml
-
-    accuracy = settings.accuracy if isinstance(settings.accuracy, str) else repr(settings.accuracy)
-    return {"scene": scene_to_toml(scene), "end_time": settings.end_time, "accuracy": accuracy,
-            "stop_when_final": list(settings.stop_when_final), "impact_threshold": settings.impact_threshold}
-
-
-def _rows_in_file(file, labels: list[tuple]) -> dict[tuple, dict]:
-    """The rows a previous run of this sweep left in ``file``, by their parameter values; SceneError if it
-    holds a point that is not in this sweep (another sweep's file)."""
-    wanted = set(labels)
-    existing = file.read()
-    done: dict[tuple, dict] = {}
-    for row in existing.astype(object).where(existing.notna(), None).to_dict("records"):
-        label = tuple(row[key] for key in file.params)
-        if label not in wanted:
-            raise SceneError("out", f"{file.path} holds points that are not in this sweep (e.g. "
-                                    f"{dict(zip(file.params, label))}): choose another file, or delete it")
-        done.setdefault(label, row)
-    return done
-
-
-class _Bar:
-    """Progress of a sweep: a tqdm bar, a callable ``progress(done, total)``, or nothing."""
-
-    def __init__(self, bar=None, callback=None, total: int = 0, initial: int = 0):
-        self.bar, self.callback, self.total, self.done = bar, callback, total, initial
-
-    def __call__(self, count: int) -> None:
-        self.done += count
-        if self.bar is not None:
-            self.bar.update(count)
-        if self.callback is not None:
-            self.callback(self.done, self.total)
-
-    def close(self) -> None:
-        if self.bar is not None:
-            self.bar.close()
-
-
-def _progress_bar(progress, total: int, initial: int) -> _Bar:
-    import sys
-
-    if callable(progress):
-        return _Bar(callback=progress, total=total, initial=initial)
-    if not progress or not sys.stderr.isatty():
-        return _Bar(total=total, initial=initial)
-    from tqdm import tqdm
-
-    return _Bar(tqdm(total=total, initial=initial, unit="point", desc="sweep", dynamic_ncols=True, smoothing=0.1),
-                total=total, initial=initial)
+from .grid_sweep import run_sweep  # noqa: E402  (public here: mbs_models.studies.sweep.run_sweep)

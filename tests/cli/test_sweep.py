@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import io
 import json
+import re
 
 import pandas as pd
 import pytest
@@ -141,10 +143,84 @@ def test_a_sweep_over_gaps_in_millimetres_warns_once_before_it_runs(tmp_path, ca
     assert main(["sweep", "model_ii", "--param", "contact.gap=0,40", "--out", str(out), "--end-time", "0.2",
                  "--accuracy", "draft", "--workers", "1", "--json"]) == 0
     captured = capsys.readouterr()
-    [line] = captured.err.strip().splitlines()
+    line, announced = captured.err.strip().splitlines()  # the warning, then the sweep's announcement
     assert line.startswith("recoil: warning: absorber.contact.gap = 40 m is beyond")
+    assert announced.startswith("sweep: 2 points (2)")
     assert json.loads(captured.out)["points"] == 2  # and the sweep ran every point
     assert main(["sweep", "model_ii", "--param", "contact.gap=0,40", "--out", str(out), "--end-time", "0.2",
                  "--accuracy", "draft", "--workers", "1"]) == 0  # resumed: the text summary
     captured = capsys.readouterr()
     assert "$" not in captured.out + captured.err
+
+
+def test_sweep_says_how_many_points_and_about_how_long_first(tmp_path, capsys):
+    out = tmp_path / "s.csv"
+    argv = ["sweep", "model_i", *GRID, "--out", str(out), "--end-time", "1", "--workers", "2", "--json"]
+    assert main(argv) == 0
+    err = capsys.readouterr().err
+    assert re.fullmatch(r"sweep: 4 points \(2 x 2\), ~[0-9.]+ ms per point on 2 workers: about [0-9.]+ s "
+                        r"\(an estimate from one point's solve\)\n", err), err
+    assert main(argv) == 0
+    assert capsys.readouterr().err == f"sweep: 4 points (2 x 2), 4 already in {out}: nothing to run\n"
+
+
+def test_a_grid_beyond_the_limit_exits_2_without_large(tmp_path, capsys):
+    out = tmp_path / "big.csv"
+    argv = ["sweep", "model_ii", "--param", "absorber.mass=1:1000:10000", "--param", "contact.gap=0:0.1:10000",
+            "--out", str(out)]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err == ("recoil: error: --large: the grid has 100,000,000 points (10,000 x 10,000), more than the "
+                   "1,000,000 a sweep runs unless asked: give --large to run it anyway\n")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_large_runs_a_grid_beyond_the_limit(tmp_path, capsys, monkeypatch):
+    from mbs_models.studies import grid as grid_module
+
+    monkeypatch.setattr(grid_module, "MAX_POINTS", 3)
+    out = tmp_path / "s.csv"
+    argv = ["sweep", "model_i", *GRID, "--out", str(out), "--end-time", "0.5", "--workers", "1"]
+    assert main(argv) == 2
+    assert "4 points (2 x 2), more than the 3" in capsys.readouterr().err and not out.exists()
+    assert main([*argv, "--large"]) == 0
+    assert "4 points: 4 run" in capsys.readouterr().out and len(pd.read_csv(out)) == 4
+
+
+def test_a_killed_sweep_resumes_to_exactly_the_uninterrupted_table(tmp_path):
+    """SIGKILL (the process and its pool) while rows are being written, then the same command again: the table
+    is the one an uninterrupted run gives (wall times aside)."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    from mbs_models import run_sweep
+
+    params = ["absorber.mass=100,400,1000", "contact.gap=0:0.1:100"]
+    out = tmp_path / "s.csv"
+    argv = ["sweep", "model_i", *[a for p in params for a in ("--param", p)], "--out", str(out), "--end-time", "1",
+            "--accuracy", "draft"]
+    proc = subprocess.Popen([sys.executable, "-m", "mbs_models", *argv, "--workers", "2"], start_new_session=True,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                            env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)})
+    try:
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline and proc.poll() is None:
+            if out.exists() and out.read_bytes().count(b"\n") > 12:
+                break
+            time.sleep(0.005)
+        running = proc.poll() is None
+    finally:
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait()
+    assert running, "the sweep ended before it could be killed"
+    rows = out.read_bytes().count(b"\n") - 1
+    assert 12 <= rows < 300
+    assert main([*argv, "--workers", "1"]) == 0
+    expected = run_sweep(model_i(), {"absorber.mass": "100,400,1000", "contact.gap": "0:0.1:100"}, end_time=1.0,
+                         accuracy="draft", workers=1, progress=False)
+    resumed = pd.read_csv(out, keep_default_na=False, na_values=[""])
+    expected_text = pd.read_csv(io.StringIO(expected.to_csv(index=False)), keep_default_na=False, na_values=[""])
+    pd.testing.assert_frame_equal(resumed.drop(columns="wall_time"), expected_text.drop(columns="wall_time"))

@@ -8,7 +8,7 @@ import pytest
 from mbs_models import Conventions, SceneError, load_scene, model_i, model_ii
 from mbs_models.elements.contact_laws import Contact
 from mbs_models.scene.overrides import (apply_overrides, check_keys, parse_assignment, parse_spec, parse_value,
-                                        resolve_key)
+                                        resolve_key, spec_size)
 from mbs_models.scenes import scene_path
 
 
@@ -158,3 +158,14 @@ def test_bad_specs_name_the_key(spec, needle):
     with pytest.raises(SceneError, match=needle) as info:
         parse_spec(spec, "absorber.mass")
     assert info.value.key == "absorber.mass" and "\n" not in str(info.value)
+    with pytest.raises(SceneError, match=needle):
+        spec_size(spec, "absorber.mass")
+
+
+@pytest.mark.parametrize("spec", ["100,500,1000", "0.5", "[[[0.0, 3e-4]], 2e-4]", "0:0.12:13", "1:-1:3"])
+def test_spec_size_is_the_number_of_values(spec):
+    assert spec_size(spec) == len(parse_spec(spec))
+
+
+def test_spec_size_of_a_range_makes_no_values():
+    assert spec_size("0:1:1000000000000") == 10**12   # 10^12 values would be 8 TB: the COUNT is read, not made

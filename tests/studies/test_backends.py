@@ -8,7 +8,14 @@ import pytest
 
 from mbs_models import SceneError
 from mbs_models.studies.backends import (BACKENDS, ProcessBackend, SerialBackend, batch_size, import_distributed,
-                                         make_backend)
+                                         in_flight, make_backend)
+
+
+def _pid(task) -> int:
+    """The process that ran the task."""
+    import os
+
+    return os.getpid()
 
 
 def test_backend_map():
@@ -106,3 +113,59 @@ def _alive(pid: int) -> bool:
             return handle.read().split(")")[-1].split()[0] != "Z"
     except OSError:
         return False
+
+
+def _counted(tasks, pulled):
+    for task in tasks:
+        pulled.append(task)
+        yield task
+
+
+@pytest.mark.parametrize("backend", [SerialBackend(), ProcessBackend(2)], ids=["serial", "processes"])
+def test_tasks_are_taken_as_results_are_read(backend):
+    """At most ``in_flight`` tasks are taken ahead of the results read: a generator of a million tasks is read
+    as far as the run goes, never made whole."""
+    pulled = []
+    with backend:
+        results = backend.run(abs, _counted(range(-1, -1_000_000, -1), pulled), in_flight=3)
+        first = [next(results) for _ in range(5)]
+        assert len(pulled) <= 5 + 3
+        results.close()
+    assert all(r >= 1 for r in first) and len(pulled) <= 8
+
+
+def test_the_pool_is_kept_between_runs_and_not_after_an_early_end():
+    import os
+
+    with ProcessBackend(2) as backend:
+        pids = set(backend.run(_pid, range(8)))
+        assert pids and os.getpid() not in pids
+        assert backend._pool is not None
+        again = set(backend.run(_pid, range(8)))
+        assert again <= pids                  # the same worker processes
+        results = backend.run(_pid, range(8))
+        next(results)
+        results.close()                       # a caller that stops reading: the pool goes
+        assert backend._pool is None
+        assert set(backend.run(_pid, range(4))).isdisjoint(pids)   # a new pool
+    assert backend._pool is None
+
+
+def test_in_flight_per_worker():
+    assert in_flight(2) == 8 and in_flight(1) == 4
+    with pytest.raises(SceneError) as info:
+        list(ProcessBackend(2).run(abs, [1], in_flight=0))
+    assert info.value.key == "in_flight"
+
+
+def test_dask_takes_tasks_as_results_are_read(dask_cluster):
+    from mbs_models.studies.backends import DaskBackend
+
+    pulled = []
+    with DaskBackend(dask_cluster.scheduler_address) as backend:
+        assert backend.workers >= 1
+        results = backend.run(abs, _counted(range(-1, -100_000, -1), pulled), in_flight=4)
+        first = [next(results) for _ in range(6)]
+        assert all(r >= 1 for r in first) and len(pulled) <= 6 + 4
+        results.close()
+        assert sorted(backend.run(abs, [-3, -1, -2])) == [1, 2, 3]

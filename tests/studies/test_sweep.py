@@ -6,6 +6,7 @@ from __future__ import annotations
 import os
 import signal
 
+import numpy as np
 import pandas as pd
 import pytest
 
@@ -219,14 +220,6 @@ def test_stop_when_final_reaches_the_points():
 
 
 # ================================================================================================ Dask
-@pytest.fixture(scope="module")
-def dask_cluster():
-    distributed = pytest.importorskip("dask.distributed")
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
-                                  dashboard_address=None) as cluster:
-        yield cluster
-
-
 def test_dask_equals_serial(dask_cluster):
     serial = run_sweep(model_ii(), FIG_GRID, end_time=1.0, workers=1, progress=False)
     on_cluster = run_sweep(model_ii(), FIG_GRID, end_time=1.0, scheduler=dask_cluster.scheduler_address,
@@ -314,3 +307,227 @@ def test_a_file_computed_with_other_settings_is_not_resumed(tmp_path, change):
     assert path.read_text() == before
     table = run_sweep(params={"contact.gap": [0.0, 0.01]}, workers=1, progress=False, out=path, **arguments)
     assert table.attrs["sweep"]["resumed"] == 1
+
+
+# ================================================================================================ streaming
+class _Stop(Exception):
+    """Ends a sweep from its progress callback (as an interrupt would)."""
+
+
+def _instant_point(scene, overrides, settings=None):
+    """evaluate_point without a solve: the grid, scheduling and table layers alone (a 4 ms 'solve')."""
+    return {**overrides, "wall_time": 0.004, "status": "ok", "error": None}
+
+
+def _stop_after(points: int):
+    def progress(done, total):
+        if done >= points:
+            raise _Stop
+    return progress
+
+
+def _peak_bytes(run) -> int:
+    """The peak of Python's (and numpy's) allocations while ``run()`` runs, over what was held before."""
+    import tracemalloc
+
+    tracemalloc.start()
+    try:
+        base = tracemalloc.get_traced_memory()[0]
+        try:
+            run()
+        except _Stop:
+            pass
+        return tracemalloc.get_traced_memory()[1] - base
+    finally:
+        tracemalloc.stop()
+
+
+GRID_1E3 = {"absorber.mass": "1:1000:10", "contact.gap": "0:0.1:10", "contact.stiffness": "1e8:3e8:10"}
+GRID_1E7 = {"absorber.mass": "1:1000:100", "contact.gap": "0:0.1:100", "contact.stiffness": "1e8:3e8:1000"}
+
+
+def test_memory_does_not_grow_with_the_grid(tmp_path, monkeypatch):
+    """Scheduling 100 points of a 10^7-point grid (then resuming it) holds no more than of a 10^3-point grid:
+    nothing per point is kept but, on resume, one bit per grid index up to the largest held (10^7 / 8 bytes =
+    1.25 MB at most).  A list of 10^7 indices alone would be 80 MB; the tolerance, 2.5 MB, covers the bitmap
+    and the grid's 1,200 values."""
+    monkeypatch.setattr(point_module, "evaluate_point", _instant_point)
+    run_sweep(model_i(), {"contact.gap": [0.0, 0.01]}, workers=1, progress=False, out=tmp_path / "warm.csv")
+    peaks = {}
+    for name, grid in {"1e3": GRID_1E3, "1e7": GRID_1E7}.items():
+        path = tmp_path / f"{name}.csv"
+        for attempt in (1, 2):    # a fresh run, then one resuming its file
+            peaks[name, attempt] = _peak_bytes(lambda: run_sweep(
+                model_i(), grid, workers=1, out=path, large=True, table=False, progress=_stop_after(100 * attempt)))
+        assert len(pd.read_csv(path)) >= 200
+    assert peaks["1e7", 1] - peaks["1e3", 1] < 2_500_000, peaks
+    assert peaks["1e7", 2] - peaks["1e3", 2] < 2_500_000, peaks
+
+
+def test_the_points_are_made_as_the_backend_takes_them(monkeypatch):
+    """The backend gets a generator of tasks, and takes them as it goes: a serial run of a 10^7-point grid
+    stopped after 100 points has made ~100 points, not 10^7."""
+    from mbs_models.studies import backends, grid as grid_module
+
+    monkeypatch.setattr(point_module, "evaluate_point", _instant_point)
+    made = []
+    point = grid_module.Grid.point
+
+    def counted(self, index):
+        made.append(index)
+        return point(self, index)
+
+    monkeypatch.setattr(grid_module.Grid, "point", counted)
+    seen = []
+    run = backends.SerialBackend.run
+
+    def recording(self, function, tasks, **kwargs):
+        seen.append(tasks)
+        return run(self, function, tasks, **kwargs)
+
+    monkeypatch.setattr(backends.SerialBackend, "run", recording)
+    with pytest.raises(_Stop):
+        run_sweep(model_i(), GRID_1E7, workers=1, large=True, batch_size=10, progress=_stop_after(100))
+    assert not isinstance(seen[-1], (list, tuple)) and iter(seen[-1]) is seen[-1]    # a generator
+    assert 100 <= len(made) <= 110 and made[4:] == sorted(made[4:])    # 4 probes, then in grid order
+
+
+def test_a_grid_beyond_the_limit_needs_large(tmp_path, monkeypatch):
+    from mbs_models.studies import grid as grid_module
+    from mbs_models.studies.grid import GridTooLarge
+
+    path = tmp_path / "s.csv"
+    with pytest.raises(GridTooLarge) as info:
+        run_sweep(model_i(), {"absorber.mass": "1:1000:10000", "contact.gap": "0:0.1:10000"}, out=path)
+    assert info.value.key == "large" and "100,000,000 points (10,000 x 10,000)" in str(info.value)
+    assert "more than the 1,000,000" in str(info.value) and "large=True" in str(info.value)
+    assert list(tmp_path.iterdir()) == []                       # nothing written
+    monkeypatch.setattr(grid_module, "MAX_POINTS", 2)
+    params = {"contact.gap": [0.0, 0.01, 0.02]}
+    with pytest.raises(SceneError, match="3 points"):
+        run_sweep(model_i(), params, end_time=0.2, workers=1, progress=False)
+    table = run_sweep(model_i(), params, end_time=0.2, workers=1, progress=False, large=True)
+    assert len(table) == 3 and (table["status"] == "ok").all()
+    with pytest.raises(SceneError) as info:
+        run_sweep(model_i(), params, large="yes")
+    assert info.value.key == "large"
+
+
+def test_the_announcement_counts_and_times_the_points(monkeypatch):
+    """4 points spread over the grid run first; the line says their mean solve (4 ms here) times the points
+    to run over the workers: 10,000 x 4 ms / 1 = 40 s."""
+    monkeypatch.setattr(point_module, "evaluate_point", _instant_point)
+    lines = []
+    with pytest.raises(_Stop):
+        run_sweep(model_i(), {"absorber.mass": "1:1000:100", "contact.gap": "0:0.1:100"}, workers=1,
+                  announce=lines.append, progress=_stop_after(10))
+    assert lines == ["sweep: 10,000 points (100 x 100), ~4.0 ms per point on 1 worker: about 40 s "
+                     "(an estimate from the mean solve of 4 points)"]
+
+
+def test_the_announcement_comes_before_the_others_run(monkeypatch):
+    events = []
+
+    def point(scene, overrides, settings=None):
+        events.append("point")
+        return _instant_point(scene, overrides, settings)
+
+    monkeypatch.setattr(point_module, "evaluate_point", point)
+    run_sweep(model_i(), {"contact.gap": "0:0.1:50"}, workers=1, batch_size=10,
+              announce=lambda line: events.append("line"), progress=lambda done, total: events.append(done))
+    assert events[:6] == ["point"] * 4 + ["line", 4]                 # the 4 timed points, the line, then the bar
+    assert events[6:] == (["point"] * 10 + [14, ] + ["point"] * 10 + [24] + ["point"] * 10 + [34]
+                          + ["point"] * 10 + [44] + ["point"] * 6 + [50])
+
+
+def test_probes_spread_over_every_key():
+    from mbs_models.studies.grid import make_grid
+    from mbs_models.studies.grid_sweep import probe_indices
+    from mbs_models.studies.point_set import PointSet
+
+    grid = make_grid(model_i(), {"absorber.mass": "1:1000:40", "contact.gap": "0:0.1:25"})
+    picks = probe_indices(PointSet(), grid, 4)
+    positions = [divmod(i, 25) for i in picks]
+    assert positions == [(5, 3), (15, 9), (25, 15), (35, 21)]    # (2j + 1) n / 8 of each key's 40 and 25 values
+    held = PointSet()
+    held.add(np.array(picks[:1]))
+    assert probe_indices(held, grid, 4)[0] == picks[0] + 1           # the next missing point
+
+
+def test_announcement_lines():
+    from mbs_models.studies.grid_sweep import announcement, duration_text
+
+    from mbs_models.studies.grid import Grid
+
+    grid = Grid(("absorber.mass", "contact.gap"), (tuple(range(1, 10001)), tuple(range(10000))))
+    line = announcement(grid, 0, 10**8, 2, 0.004, 4)
+    assert line == ("sweep: 100,000,000 points (10,000 x 10,000), ~4.0 ms per point on 2 workers: about 2.3 days "
+                    "(an estimate from the mean solve of 4 points)")       # 1e8 x 4 ms / 2 = 2e5 s = 2.31 days
+    resumed = announcement(grid, 5000, 10**8 - 5000, 2, 0.004, 4, where="big.csv")
+    assert ", 5,000 already in big.csv, ~4.0 ms" in resumed and "for the 99,995,000 to run" in resumed
+    assert announcement(grid, 10**8, 0, 2, None, 0, where="big.csv").endswith("already in big.csv: nothing to run")
+    assert "no time estimate: all 4 points tried failed" in announcement(grid, 0, 10**8, 2, None, 4)
+    assert [duration_text(s) for s in (0.43, 42, 600, 3 * 3600, 2e5, 4e8)] == [
+        "0.4 s", "42 s", "10 min", "3.0 h", "2.3 days", "12.7 years"]
+
+
+def test_table_false_returns_the_summary_and_lists_the_first_failures(tmp_path, monkeypatch):
+    from mbs_models.studies import grid_sweep
+
+    monkeypatch.setattr(grid_sweep, "SUMMARY_FAILURES", 2)
+    path = tmp_path / "f.csv"
+    params = {"contact.law": ["hunt-crossley", "flores"], "contact.restitution": [0.3, 0.5, 0.7]}
+    summary = run_sweep(model_i(), params, end_time=0.2, workers=1, progress=False, out=path, table=False)
+    table = pd.read_csv(path)
+    assert summary["points"] == 6 and summary["failed"] == 3 and summary["out"] == str(path)
+    assert (table["status"] == "SceneError").sum() == 3 and table["contact.law"].tolist()[:3] == ["hunt-crossley"] * 3
+    assert summary["failures"] == [{"contact.law": "hunt-crossley", "contact.restitution": r, "status": "SceneError",
+                                    "error": table["error"][i]} for i, r in enumerate([0.3, 0.5])]
+    with pytest.raises(SceneError) as info:
+        run_sweep(model_i(), params, table=False)
+    assert info.value.key == "table"
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".parquet"])
+def test_a_file_in_any_order_is_resumed_and_ends_in_grid_order(tmp_path, suffix):
+    """A file whose rows are in finish order (shuffled here), with points missing, resumes and ends in grid order;
+    the kept rows are those of the file (their wall times)."""
+    full = run_sweep(model_i(), FIG_GRID, end_time=0.5, workers=1, progress=False)
+    kept = full.drop(index=[1, 4]).sample(frac=1.0, random_state=3)
+    path = tmp_path / f"s{suffix}"
+    if suffix == ".csv":
+        kept.to_csv(path, index=False)
+    else:
+        kept.to_parquet(path, index=False)
+    resumed = run_sweep(model_i(), FIG_GRID, end_time=0.5, workers=2, progress=False, out=path)
+    assert resumed.attrs["sweep"]["resumed"] == 4 and resumed.attrs["sweep"]["run"] == 2
+    pd.testing.assert_frame_equal(_values(resumed), _values(full))
+    assert resumed["wall_time"][[0, 2, 3, 5]].tolist() == full["wall_time"][[0, 2, 3, 5]].tolist()
+    written = pd.read_csv(path) if suffix == ".csv" else pd.read_parquet(path)
+    assert written[["absorber.mass", "contact.gap"]].values.tolist() == full[["absorber.mass", "contact.gap"]].values.tolist()
+    assert [p.name for p in tmp_path.iterdir() if not p.name.endswith(".sweep.json")] == [path.name]
+
+
+def test_a_parquet_table_journals_its_rows_until_the_end(tmp_path, monkeypatch):
+    """Parquet cannot be appended to: rows go to FILE.parquet.rows.csv, which a killed run leaves behind, the
+    next run resumes from, and the end folds into the table."""
+    path = tmp_path / "s.parquet"
+    journal = tmp_path / "s.parquet.rows.csv"
+    uninterrupted = run_sweep(model_ii(), FIG_GRID, end_time=0.5, workers=1, progress=False)
+    seen = []
+
+    def look(done, total):
+        seen.append(journal.exists() and not path.exists())
+        if done == 4:
+            raise SystemExit   # not an Exception: as a kill, nothing is folded in (only a KeyboardInterrupt is)
+
+    monkeypatch.setattr("mbs_models.studies.grid_sweep._FileSink.abandon", lambda self: None)
+    with pytest.raises(SystemExit):
+        run_sweep(model_ii(), FIG_GRID, end_time=0.5, workers=1, batch_size=1, progress=look, out=path)
+    assert all(seen) and len(pd.read_csv(journal)) == 4
+    monkeypatch.undo()
+    resumed = run_sweep(model_ii(), FIG_GRID, end_time=0.5, workers=1, progress=False, out=path)
+    assert resumed.attrs["sweep"]["resumed"] == 4 and not journal.exists()
+    pd.testing.assert_frame_equal(_values(resumed), _values(uninterrupted))
+    pd.testing.assert_frame_equal(_values(pd.read_parquet(path).astype(object).where(lambda t: t.notna(), None)),
+                                  _values(uninterrupted.astype(object).where(uninterrupted.notna(), None)))

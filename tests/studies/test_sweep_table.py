@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import sys
 
+import numpy as np
 import pandas as pd
 import pytest
 
@@ -29,10 +30,9 @@ def test_types_are_fixed_by_the_column():
 
 @pytest.mark.parametrize("suffix", [".csv", ".parquet"])
 def test_round_trip_is_exact(tmp_path, suffix):
-    file = SweepFile(tmp_path / f"t{suffix}", PARAMS, METRICS, parquet_interval=0.0)
+    file = SweepFile(tmp_path / f"t{suffix}", PARAMS, METRICS)
     file.append(ROWS[:1])
     file.append(ROWS[1:])
-    file.flush()
     again = SweepFile(tmp_path / f"t{suffix}", PARAMS, METRICS).read()
     pd.testing.assert_frame_equal(again, frame(ROWS, PARAMS, METRICS))
     assert again["contact.gap"][1] == 1 / 3 and again["max_barrel_displacement"][0] == 0.1 + 0.2
@@ -75,14 +75,16 @@ def test_files_honour_the_umask(tmp_path, suffix, mask, mode):
 
     saved = os.umask(mask)
     try:
-        file = SweepFile(tmp_path / f"t{suffix}", PARAMS, METRICS, parquet_interval=0.0)
+        file = SweepFile(tmp_path / f"t{suffix}", PARAMS, METRICS)
         file.write_settings({"end_time": 10.0})
         file.append(ROWS[:1])
+        file.finish(lambda chunk: np.zeros(len(chunk), dtype=np.int64))
+        file.append(ROWS[1:])
         file.write_all(frame(ROWS, PARAMS, METRICS))
-        file.flush()
+        file.finish(lambda chunk: np.arange(len(chunk), dtype=np.int64))
     finally:
         os.umask(saved)
-    assert len(list(tmp_path.iterdir())) == 2  # the table and its settings, no temporary file
+    assert len(list(tmp_path.iterdir())) == 2  # the table and its settings, no temporary file or journal
     for path in tmp_path.iterdir():
         assert stat.S_IMODE(path.stat().st_mode) == mode, path.name
 
@@ -100,3 +102,92 @@ def test_parquet_without_pyarrow_names_the_extra(tmp_path, monkeypatch):
     with pytest.raises(SceneError, match=r"recoil-mbs\[parquet\]"):
         check_out(tmp_path / "t.parquet")
     assert check_out(tmp_path / "t.csv") == tmp_path / "t.csv"
+
+
+def _many_rows(count: int) -> list[dict]:
+    """``count`` rows of both kinds (ok and failed), gaps i / 7 (floats with all their digits)."""
+    return [{**ROWS[i % 2], "contact.gap": i / 7, "impacts": None if i % 2 else i} for i in range(count)]
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".parquet"])
+def test_finish_puts_the_rows_in_order_chunk_by_chunk(tmp_path, suffix):
+    """Rows appended in any order end in the order of their index, read and written 7 rows at a time, through
+    several sorted runs (a carry of 5 rows): the table equals the one sorted in memory, and a CSV file has the
+    very bytes of one to_csv of it."""
+    rows = _many_rows(60)
+    order = np.random.default_rng(5).permutation(60)
+    path = tmp_path / f"t{suffix}"
+    file = SweepFile(path, PARAMS, METRICS, chunk_rows=7)
+    for start in range(0, 60, 4):
+        file.append([rows[i] for i in order[start:start + 4]])
+    seen = []
+    stats = file.finish(lambda chunk: np.rint(chunk["contact.gap"].to_numpy() * 7).astype(np.int64),
+                        on_chunk=seen.append, carry_rows=5, fan_in=2)
+    assert stats.runs > 2 and stats.rows_out == 60
+    expected = frame(rows, PARAMS, METRICS)
+    pd.testing.assert_frame_equal(SweepFile(path, PARAMS, METRICS).read(), expected)
+    pd.testing.assert_frame_equal(pd.concat(seen, ignore_index=True), expected)
+    if suffix == ".csv":
+        whole = tmp_path / "whole.csv"
+        expected.to_csv(whole, index=False)
+        assert path.read_bytes() == whole.read_bytes()
+    else:
+        assert not file.journal_path.exists()
+        read = pd.read_parquet(path)
+        assert str(read["impacts"].dtype) == "Int64" and read["contact.gap"].tolist() == [i / 7 for i in range(60)]
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([path.name] + (["whole.csv"] if suffix == ".csv" else []))
+
+
+def test_reading_in_chunks_equals_reading_whole(tmp_path):
+    rows = _many_rows(25)
+    SweepFile(tmp_path / "t.csv", PARAMS, METRICS).append(rows)
+    chunks = list(SweepFile(tmp_path / "t.csv", PARAMS, METRICS, chunk_rows=4).chunks())
+    assert [len(c) for c in chunks] == [4] * 6 + [1]
+    pd.testing.assert_frame_equal(pd.concat(chunks, ignore_index=True), frame(rows, PARAMS, METRICS))
+
+
+def test_a_parquet_table_appends_to_its_journal(tmp_path):
+    file = SweepFile(tmp_path / "t.parquet", PARAMS, METRICS)
+    file.append(ROWS[:1])
+    assert file.journal_path == tmp_path / "t.parquet.rows.csv" and not file.path.exists()
+    assert file.has_rows()
+    file.finish(lambda chunk: np.zeros(len(chunk), dtype=np.int64))
+    file.append(ROWS[1:])           # the table and a journal: both are read
+    pd.testing.assert_frame_equal(SweepFile(file.path, PARAMS, METRICS).read(), frame(ROWS, PARAMS, METRICS))
+
+
+def test_kinds_fix_the_parameter_types(tmp_path):
+    """A text parameter whose values look like numbers stays text, whatever the rows in the file."""
+    rows = [{**ROWS[0], "contact.law": "0.0003"}]
+    kinds = {"contact.gap": "float", "contact.law": "text"}
+    SweepFile(tmp_path / "t.csv", PARAMS, METRICS, kinds=kinds).append(rows)
+    read = SweepFile(tmp_path / "t.csv", PARAMS, METRICS, kinds=kinds).read()
+    assert read["contact.law"].tolist() == ["0.0003"]
+    with pytest.raises(SceneError, match="cannot read"):
+        SweepFile(tmp_path / "t.csv", PARAMS, METRICS, kinds={"contact.gap": "float", "contact.law": "bool"}).read()
+
+
+def test_a_cut_line_is_found_from_the_end(tmp_path):
+    from mbs_models.studies.sweep_table import drop_cut_line
+
+    path = tmp_path / "t.csv"
+    path.write_bytes(b"a,b\n" + b"1,2\n" * 50_000 + b"3,")
+    drop_cut_line(path, block=64)
+    assert path.read_bytes() == b"a,b\n" + b"1,2\n" * 50_000
+    drop_cut_line(path)                               # nothing cut: unchanged
+    assert path.stat().st_size == 4 + 4 * 50_000
+    path.write_bytes(b"a,")                            # the header itself cut short
+    drop_cut_line(path, block=1)
+    assert path.read_bytes() == b""
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".parquet"])
+def test_a_file_of_its_header_alone_has_no_rows(tmp_path, suffix):
+    kinds = {"contact.gap": "float", "contact.law": "text"}
+    path = tmp_path / f"t{suffix}"
+    empty = frame([], PARAMS, METRICS, kinds)
+    empty.to_csv(path, index=False) if suffix == ".csv" else empty.to_parquet(path, index=False)
+    file = SweepFile(path, PARAMS, METRICS, kinds=kinds)
+    assert list(file.chunks()) == []
+    file.append(ROWS)
+    pd.testing.assert_frame_equal(file.read(), frame(ROWS, PARAMS, METRICS, kinds))
