@@ -7,6 +7,10 @@ Two kinds of failure matter to users and are kept apart:
 * :class:`SimulationError` -- the input was valid but the *solve* failed (the solver stopped early,
   produced NaN, or a user function raised).  Nothing half-finished is ever returned as a result.
 
+A third, of the machinery rather than of a point: :class:`ClusterError` -- the Dask cluster a sweep or an
+optimisation runs on failed it (its scheduler cannot be reached or was lost, no worker came); the whole run
+stops (a sweep's finished rows are kept in its file).
+
 One warning category: :class:`UnitWarning` -- the input is valid but a magnitude is implausible (a unit
 slip?); the run goes on.
 """
@@ -37,6 +41,13 @@ class SceneError(RecoilError, ValueError):
 
 class SimulationError(RecoilError, RuntimeError):
     """A solve failed; the message says why (early stop, NaN, exception in a user function...)."""
+
+
+class ClusterError(RecoilError, RuntimeError):
+    """The Dask cluster of a run failed: its scheduler cannot be reached or was lost, no worker has been
+    available for longer than the run's ``worker_timeout``, or workers kept dying on one task.  An error of
+    the whole run, never of a point (:mod:`mbs_models.studies.backends`); the message says what happened and
+    what was kept."""
 
 
 class UnitWarning(UserWarning):

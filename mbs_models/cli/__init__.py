@@ -1,7 +1,7 @@
 """The ``recoil`` command line.
 
-Exit codes: 0 success; 1 a simulation or check failed; 2 bad input (one line on stderr naming the
-problem, never a traceback for user mistakes).  A :class:`~mbs_models.errors.UnitWarning` (an implausible
+Exit codes: 0 success; 1 a simulation or check failed, or the Dask cluster of a run did; 2 bad input (one
+line on stderr naming the problem, never a traceback for user mistakes).  A :class:`~mbs_models.errors.UnitWarning` (an implausible
 magnitude, a contact that can never close: :mod:`mbs_models.engine.unit_slips`) is one line on stderr,
 ``recoil: warning: ...``, and the command goes on.
 """
@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Sequence
 
 from .. import __version__
-from ..errors import SceneError, SimulationError, UnitWarning
+from ..errors import ClusterError, SceneError, SimulationError, UnitWarning
 from ..scene import load_scene
 from . import run
 from .sweep import add_set_argument, add_sweep_parser, apply_sets
@@ -310,6 +310,9 @@ def _main(argv: Sequence[str] | None) -> int:
         return EXIT_BAD_INPUT
     except SimulationError as exc:
         print(f"recoil: simulation failed: {exc}", file=sys.stderr)
+        return EXIT_FAILED
+    except ClusterError as exc:   # the Dask cluster failed the run (unreachable, lost, no workers)
+        print(f"recoil: error: {exc}", file=sys.stderr)
         return EXIT_FAILED
     except BrokenPipeError:  # piped into a program that stopped reading (head): the run itself succeeded
         try:  # Python's documented recipe: the interpreter's final flush goes to /dev/null, not a traceback

@@ -2,7 +2,8 @@
 [--out DIR]``: the best design within the bounds, its history (CSV) and a plot.
 
 Every argument is checked before the first simulation and before DIR is created (one line, exit 2).  Exit
-code 1 when no feasible design was found (the least violating one is still written and reported).
+code 1 when no feasible design was found (the least violating one is still written and reported), or when
+the Dask cluster of ``--scheduler`` fails the run (unreachable, lost, no worker for ``--worker-timeout`` s).
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ import sys
 from pathlib import Path
 
 from ..errors import SceneError
+from .sweep import add_worker_timeout_argument
 
 
 def _progress(message: str) -> None:
@@ -21,6 +23,7 @@ def _progress(message: str) -> None:
 def _cmd_optimise(args) -> int:
     from . import _resolve_scene
     from ..outputs import prepare_output_dir
+    from ..studies.backends import check_backend
     from ..studies.optimise import check_problem, optimise, parse_bound
 
     scene = _resolve_scene(args.scene)
@@ -46,9 +49,14 @@ def _cmd_optimise(args) -> int:
         raise SceneError("--workers", "give either --workers (a local pool) or --scheduler (a Dask cluster)")
     if args.workers is not None and args.workers < 1:
         raise SceneError("--workers", f"must be >= 1, got {args.workers}")
+    try:
+        check_backend(args.workers, args.scheduler, args.worker_timeout)
+    except SceneError as exc:
+        raise SceneError(f"--{exc.key.replace('_', '-')}", exc.message) from None
     out = prepare_output_dir(Path(args.out))  # bad --out: exit 2 before any simulation
     result = optimise(scene, bounds, args.minimise, args.constraint or (), workers=args.workers,
-                      scheduler=args.scheduler, stop_when_final=not args.full_run, progress=_progress, **options)
+                      scheduler=args.scheduler, worker_timeout=args.worker_timeout, stop_when_final=not args.full_run,
+                      progress=_progress, **options)
     data = result.write(out)
     if args.json:
         print(json.dumps(data, indent=2, allow_nan=False))
@@ -84,5 +92,6 @@ def add_parser(sub) -> None:
     opt.add_argument("--workers", type=int, default=None, help="local worker processes (default: all CPUs)")
     opt.add_argument("--scheduler", default=None, metavar="ADDRESS",
                      help="Dask scheduler tcp://HOST:PORT (instead of local processes)")
+    add_worker_timeout_argument(opt)
     opt.add_argument("--json", action="store_true", help="print the optimum as JSON")
     opt.set_defaults(handler=_cmd_optimise)

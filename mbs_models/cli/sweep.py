@@ -5,7 +5,9 @@
 Bad keys, specs, values and paths exit 2 with one line naming them, before anything is written, and so does
 a grid of more than 10^6 points without ``--large``; a failing point is a row of the table (``status``,
 ``error``) and the sweep goes on; running the same command again resumes (only the points not yet in the
-file run). Before the points run, one line on stderr says how many there are and about how long they take
+file run). On a Dask cluster (``--scheduler``) a malformed address exits 2; an address that does not
+answer, a scheduler lost mid-sweep or no worker for ``--worker-timeout`` seconds exits 1 with one line
+saying how many rows the file keeps (the same command resumes). Before the points run, one line on stderr says how many there are and about how long they take
 (measured on a few points spread over the grid: an estimate). The table stays in its file: memory does not
 grow with the grid. ``--set KEY=VALUE`` (``recoil run``, ``recoil validate``) changes fields of the scene
 for one run, with the same keys.
@@ -22,7 +24,7 @@ from ..studies.grid import MAX_POINTS
 
 #: run_sweep's argument names -> the options that give them.
 _OPTIONS = {"out": "--out", "scheduler": "--scheduler", "workers": "--workers", "end_time": "--end-time",
-            "accuracy": "--accuracy", "params": "--param"}
+            "accuracy": "--accuracy", "params": "--param", "worker_timeout": "--worker-timeout"}
 
 
 def add_set_argument(parser) -> None:
@@ -66,6 +68,7 @@ def add_sweep_parser(sub) -> None:
                        help="local worker processes (default: all CPUs)")
     sweep.add_argument("--scheduler", default=None, metavar="ADDRESS",
                        help="run on a Dask cluster: the scheduler's tcp://HOST:PORT (needs the cluster extra)")
+    add_worker_timeout_argument(sweep)
     sweep.add_argument("--accuracy", default="standard", choices=("draft", "standard", "reference"))
     sweep.add_argument("--end-time", type=float, default=10.0, help="simulated time in s (default 10)")
     sweep.add_argument("--large", action="store_true",
@@ -73,6 +76,13 @@ def add_sweep_parser(sub) -> None:
                             "CPU and a table of gigabytes are rarely meant)")
     sweep.add_argument("--json", action="store_true", help="print the summary as JSON (no progress bar)")
     sweep.set_defaults(handler=run_command)
+
+
+def add_worker_timeout_argument(parser) -> None:
+    """``--worker-timeout SECONDS`` (with ``--scheduler``)."""
+    parser.add_argument("--worker-timeout", type=float, default=None, metavar="SECONDS",
+                        help="with --scheduler: stop (exit 1) once the cluster has had no worker for this long "
+                             "(default 60; inf: wait for ever); a line on stderr says it is waiting")
 
 
 def run_command(args) -> int:
@@ -93,7 +103,8 @@ def run_command(args) -> int:
     try:
         summary = run_sweep(scene, params, end_time=args.end_time, accuracy=args.accuracy, workers=args.workers,
                             scheduler=args.scheduler, out=args.out, progress=not args.json, large=args.large,
-                            table=False, announce=lambda line: print(line, file=sys.stderr, flush=True))
+                            table=False, announce=lambda line: print(line, file=sys.stderr, flush=True),
+                            worker_timeout=args.worker_timeout)
     except GridTooLarge as exc:
         raise exc.with_flag("--large", "--large") from None
     except SceneError as exc:

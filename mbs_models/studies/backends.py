@@ -13,23 +13,30 @@ next one taken as one finishes, so that what a run holds does not depend on how 
   that ends early (an error, an interrupt, a caller that stops reading) shuts it down.
 * ``dask`` (:class:`DaskBackend`): the workers of a Dask distributed cluster, given as a scheduler address
   ``tcp://HOST:PORT`` or a ``dask.distributed.Client``.  The scheduler re-runs the tasks of a worker that
-  dies.  Dask is imported only here, and only then (the ``cluster`` extra: ``pip install recoil-mbs[cluster]``).
+  dies; the cluster's own faults (an address that does not answer, a lost scheduler, no worker for
+  ``worker_timeout``) stop the run with a :class:`~mbs_models.errors.ClusterError`.  Dask is imported only
+  here, and only then (the ``cluster`` extra: ``pip install recoil-mbs[cluster]``).
 
 :func:`make_backend` picks one from ``workers``/``scheduler``; :data:`BACKENDS` maps names to classes.
 """
 
 from __future__ import annotations
 
+import contextlib
 import itertools
 import math
 import multiprocessing
 import os
+import queue
+import re
+import socket
+import sys
 import time
-from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures import FIRST_COMPLETED, CancelledError, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any, Callable, Iterable, Iterator
 
-from ..errors import SceneError, SimulationError
+from ..errors import ClusterError, SceneError, SimulationError
 
 
 def default_workers() -> int:
@@ -152,54 +159,333 @@ class ProcessBackend(SerialBackend):
             pool.shutdown(wait=True, cancel_futures=True)
 
 
+#: Seconds to reach a Dask scheduler (its port answering, then Dask's handshake) before giving up.
+CONNECT_TIMEOUT = 10.0
+#: Seconds a Dask run goes on with no worker in the cluster before it stops (``worker_timeout``'s default).
+WORKER_TIMEOUT = 60.0
+#: Seconds between two looks at the cluster (its scheduler, its workers) while no task ends.
+CLUSTER_POLL = 1.0
+#: ``tcp://HOST:PORT`` or ``tls://HOST:PORT``: HOST a name, an IPv4 address or a bracketed IPv6 address.
+_ADDRESS = re.compile(r"(?P<scheme>tcp|tls)://(?P<host>\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9._-]+):(?P<port>[0-9]{1,5})")
+
+
 class DaskBackend(SerialBackend):
-    """The workers of a Dask distributed cluster: ``scheduler`` is ``"tcp://HOST:PORT"`` (a client is opened
-    and closed here) or a ``dask.distributed.Client`` (used as it is, left open)."""
+    """The workers of a Dask distributed cluster: ``scheduler`` is an address (:func:`check_scheduler`; a
+    client is opened here and closed by :meth:`close`, distributed's own log lines silenced meanwhile) or a
+    ``dask.distributed.Client`` (used as it is, left open).
+
+    The cluster's faults stop a run with a :class:`~mbs_models.errors.ClusterError`, never a hang or a
+    point's error: an address that does not answer within ``connect_timeout`` (s; default
+    :data:`CONNECT_TIMEOUT`), a scheduler lost during a run, no worker for ``worker_timeout`` (s; default
+    :data:`WORKER_TIMEOUT`, ``math.inf`` to wait for ever; ``say`` is given a line when the wait starts and
+    one when it ends: default stderr), a task whose workers kept dying (Dask's ``KilledWorker``).  A worker
+    that dies is not a fault: the scheduler runs its tasks elsewhere."""
 
     name = "dask"
 
-    def __init__(self, scheduler: Any, *, timeout: float = 10.0):
+    def __init__(self, scheduler: Any, *, connect_timeout: float = CONNECT_TIMEOUT, worker_timeout: float | None = None,
+                 say: Callable[[str], None] | None = None):
+        scheduler = check_scheduler(scheduler)
+        self.worker_timeout = check_worker_timeout(worker_timeout)
+        self.say = _to_stderr if say is None else say
         distributed = import_distributed()
+        self._restore_logging: Callable[[], None] | None = None
         if isinstance(scheduler, distributed.Client):
             self.client, self._own = scheduler, False
-        elif isinstance(scheduler, str) and scheduler.strip():
+            self.address = str(getattr(scheduler.scheduler, "address", scheduler))
+        else:   # distributed's log lines silenced while this client is open (a CLI's stderr: one line a fault)
+            self._restore_logging = silence_distributed()
             try:
-                self.client = distributed.Client(scheduler.strip(), timeout=timeout, set_as_default=False)
-            except (OSError, TimeoutError, ValueError) as exc:
-                reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-                raise SceneError("scheduler", f"cannot connect to the Dask scheduler at {scheduler!r}: "
-                                              f"{reason}") from None
-            self._own = True
-        else:
-            raise SceneError("scheduler", f"must be an address tcp://HOST:PORT or a dask.distributed.Client, "
-                                          f"got {scheduler!r}")
-        self.workers = max(1, len(self.client.scheduler_info().get("workers", {})))
+                self.client, self._own = connect(scheduler, connect_timeout), True
+            except BaseException:
+                self._restore_logging()
+                raise
+            self.address = scheduler
+        self._without_workers: float | None = None   # time.monotonic() since when the cluster has had none
+        try:
+            self.workers = max(1, self._count_workers())
+        except BaseException:
+            self.close()
+            raise
 
     def run(self, function: Callable, tasks: Iterable, *, in_flight: int | None = None) -> Iterator[Any]:
-        distributed = import_distributed()
         limit = _check_in_flight(in_flight, self.workers)
         tasks = iter(tasks)
         first = list(itertools.islice(tasks, limit))
         if not first:
             return
-        running = {self.client.submit(function, task, pure=False) for task in first}
-        del first
-        finished = distributed.as_completed(list(running), loop=self.client.loop)
+        finished: queue.SimpleQueue = queue.SimpleQueue()   # futures as they end (done, failed or cancelled)
+        running: set = set()
+        self._without_workers = None
+
+        def submit(task) -> None:
+            future = self.client.submit(function, task, pure=False)
+            running.add(future)
+            future.add_done_callback(finished.put)
+
         try:
-            for future in finished:
+            for task in first:
+                submit(task)
+            del first
+            while running:
+                future = self._next(finished)
                 running.discard(future)
-                result = future.result()
+                result = self._result(future)
                 for task in itertools.islice(tasks, 1):
-                    new = self.client.submit(function, task, pure=False)
-                    running.add(new)
-                    finished.add(new)
+                    submit(task)
                 yield result
+        except ClusterError:
+            running.clear()   # nothing to cancel: the scheduler may be gone (a request would wait for it)
+            raise
         finally:
-            self.client.cancel([f for f in running if not f.done()])
+            if running and self.client.status == "running":   # a lost scheduler holds nothing to cancel
+                with contextlib.suppress(Exception):
+                    self.client.cancel(list(running))
+
+    def _next(self, finished: queue.SimpleQueue):
+        """The next future to end; while none does, the cluster is looked at every :data:`CLUSTER_POLL` s."""
+        while True:
+            try:
+                future = finished.get(timeout=CLUSTER_POLL)
+            except queue.Empty:
+                self._check_cluster()
+                continue
+            self._workers_back()
+            return future
+
+    def _result(self, future) -> Any:
+        """The future's result; its task's own error as it is; a fault of the cluster as a ClusterError.
+
+        Fetching a result waits for ever if the worker holding it dies meanwhile (Dask computes it again once
+        it has a worker), so it is fetched by a thread of its own, looked at every :data:`CLUSTER_POLL` s; a
+        fetch left waiting by a ClusterError ends when the client closes (cutting Dask's fetch short instead
+        leaves its tasks to log errors)."""
+        if future.cancelled():
+            raise self._lost()
+        fetch = _in_thread(future.result)
+        while True:
+            try:
+                return fetch.result(timeout=CLUSTER_POLL)
+            except TimeoutError:
+                if fetch.done():   # the task's own
+                    raise
+                self._check_cluster()
+            except import_distributed().KilledWorker as exc:
+                raise ClusterError(f"Dask workers kept dying while running one task (killed, out of memory?), "
+                                   f"and the scheduler {self.address} gave it up: {_first_line(exc)}") from None
+            except OSError:   # the connection to the scheduler broke while fetching (before the client knows)
+                if future.status == "error":   # the task's own
+                    raise
+                raise self._scheduler_lost() from None
+            except CancelledError:
+                if future.cancelled():
+                    raise self._lost() from None
+                raise
+
+    def _lost(self) -> ClusterError:
+        """The error for a cancelled task: the client cancels them all when it loses its scheduler."""
+        if self.client.status != "running":
+            return self._scheduler_lost()
+        return ClusterError(f"a task was cancelled on the Dask cluster of {self.address} (by another client?)")
+
+    def _scheduler_lost(self) -> ClusterError:
+        return ClusterError(f"the Dask scheduler {self.address} was lost")
+
+    def _count_workers(self) -> int:
+        return len(self.client.nthreads())   # one request to the scheduler: worker address -> threads
+
+    def _check_cluster(self) -> None:
+        """Raise a ClusterError if the scheduler is lost or no worker has been there for ``worker_timeout``;
+        say when the wait for a worker starts and ends."""
+        if self.client.status != "running":
+            raise self._scheduler_lost()
+        try:
+            count = self._count_workers()
+        except (OSError, CancelledError):
+            raise self._scheduler_lost() from None
+        now = time.monotonic()
+        if count:
+            self._workers_back()
+            return
+        if self._without_workers is None:
+            self._without_workers = now
+            until = ("" if math.isinf(self.worker_timeout) else
+                     f"; giving up after {self.worker_timeout:g} s without one (the worker timeout)")
+            self.say(f"dask: waiting for a worker: the scheduler {self.address} has none{until}")
+        elif now - self._without_workers >= self.worker_timeout:
+            raise ClusterError(f"no Dask worker has been available at {self.address} for {self.worker_timeout:g} s "
+                               "(the worker timeout)")
+
+    def _workers_back(self) -> None:
+        if self._without_workers is not None:
+            self._without_workers = None
+            self.say(f"dask: the scheduler {self.address} has workers again; going on")
 
     def close(self) -> None:
         if self._own:
-            self.client.close()
+            self._own = False
+            close_quietly(self.client)
+        if self._restore_logging is not None:
+            restore, self._restore_logging = self._restore_logging, None
+            restore()
+
+
+def check_scheduler(scheduler: Any):
+    """``scheduler`` checked to be a Dask scheduler address -- ``tcp://HOST:PORT`` or ``tls://HOST:PORT``
+    (PORT 1-65535), or ``inproc://...`` (a scheduler in this process) -- or a ``dask.distributed.Client``;
+    returns the address (stripped) or the client.  Nothing is contacted."""
+    if isinstance(scheduler, str):
+        address = scheduler.strip()
+        match = _ADDRESS.fullmatch(address)
+        if match and 1 <= int(match["port"]) <= 65535 or address.startswith("inproc://") and len(address) > 9:
+            return address
+    elif scheduler is not None and not isinstance(scheduler, (bool, int, float)):
+        if isinstance(scheduler, import_distributed().Client):
+            return scheduler
+    raise SceneError("scheduler", f"must be a Dask scheduler address tcp://HOST:PORT (or tls://HOST:PORT; PORT "
+                                  f"1-65535) or a dask.distributed.Client, got {scheduler!r}")
+
+
+def check_worker_timeout(seconds: float | None) -> float:
+    """``seconds`` (None: :data:`WORKER_TIMEOUT`) checked to be a number of seconds > 0 (``math.inf``: no
+    limit)."""
+    seconds = WORKER_TIMEOUT if seconds is None else seconds
+    if isinstance(seconds, bool) or not isinstance(seconds, (int, float)) or not seconds > 0:
+        raise SceneError("worker_timeout", f"must be a number of seconds > 0 (inf: wait for ever), got {seconds!r}")
+    return float(seconds)
+
+
+def connect(address: str, timeout: float = CONNECT_TIMEOUT):
+    """A ``dask.distributed.Client`` of the scheduler at ``address``, or a ClusterError: at once if nothing
+    listens there (Dask itself retries a refused connection until its timeout), within ``timeout`` (s) if
+    nothing answers or what answers is not a Dask scheduler (Dask's own client can wait far longer then)."""
+    distributed = import_distributed()
+    match = _ADDRESS.fullmatch(address)
+    if match:
+        host, port = match["host"].strip("[]"), int(match["port"])
+        try:
+            socket.create_connection((host, port), timeout=timeout).close()
+        except OSError as exc:
+            reasons = {ConnectionRefusedError: "connection refused (nothing listens on that port)",
+                       socket.gaierror: f"unknown host {host!r}", TimeoutError: f"no answer within {timeout:g} s"}
+            reason = next((text for kind, text in reasons.items() if isinstance(exc, kind)), exc.strerror or str(exc))
+            raise ClusterError(f"cannot connect to the Dask scheduler at {address}: {reason}") from None
+        kind = _identity_type(address, timeout)
+        if kind != "Scheduler":
+            raise ClusterError(f"cannot connect to the Dask scheduler at {address}: {kind}")
+
+    class Client(distributed.Client):
+        """Closed at once if it cannot start (else its __del__ prints a traceback and waits 20 s)."""
+
+        def start(self, **kwargs):
+            try:
+                super().start(**kwargs)
+            except BaseException:
+                close_quietly(self, timeout)
+                raise
+
+    try:
+        with _quiet_distributed():
+            return Client(address, timeout=timeout, set_as_default=False)
+    except Exception as exc:
+        raise ClusterError(f"cannot connect to the Dask scheduler at {address} within {timeout:g} s: "
+                           f"{_first_line(exc)}") from None
+
+
+def _identity_type(address: str, timeout: float) -> str:
+    """What answers at ``address`` says it is (``"Scheduler"``), or why nothing did, within ``timeout`` (s):
+    Dask's handshake and an ``identity`` request, on an event loop of their own (in a thread: the caller's
+    may be running one)."""
+    import asyncio
+    import threading
+
+    from distributed.comm import connect as dask_connect
+    from distributed.security import Security
+
+    async def identity():
+        comm = await dask_connect(address, timeout=timeout, **Security().get_connection_args("client"))
+        try:
+            await comm.write({"op": "identity", "reply": True})
+            return await comm.read()
+        finally:
+            comm.abort()
+
+    answer: list[str] = [f"no Dask scheduler answered within {timeout:g} s"]
+
+    def ask() -> None:
+        try:
+            reply = asyncio.run(asyncio.wait_for(identity(), timeout))
+        except (asyncio.TimeoutError, TimeoutError):
+            return
+        except Exception as exc:
+            answer[0] = _first_line(exc)
+            return
+        kind = reply.get("type") if isinstance(reply, dict) else None
+        answer[0] = kind if kind == "Scheduler" else f"what answers is not a Dask scheduler (it is a {kind or 'stranger'})"
+
+    with _quiet_distributed():
+        thread = threading.Thread(target=ask, name="dask-identity", daemon=True)
+        thread.start()
+        thread.join(timeout + 5.0)
+    return answer[0]
+
+
+def _in_thread(function: Callable[[], Any]) -> Future:
+    """``function()`` called in a daemon thread of its own; its result (or error) as a Future."""
+    import threading
+
+    result: Future = Future()
+
+    def call() -> None:
+        try:
+            result.set_result(function())
+        except BaseException as exc:
+            result.set_exception(exc)
+
+    threading.Thread(target=call, name="dask-result", daemon=True).start()
+    return result
+
+
+def _first_line(exc: BaseException) -> str:
+    return str(exc).splitlines()[0] if str(exc).strip() else type(exc).__name__
+
+
+def close_quietly(client, timeout: float = CONNECT_TIMEOUT) -> None:
+    """Close ``client`` without distributed's log lines or errors (a lost scheduler's client gives up
+    reconnecting, and says so, as it closes), within about ``timeout`` (s)."""
+    with _quiet_distributed(), contextlib.suppress(Exception):
+        client.close(timeout=timeout)
+
+
+def silence_distributed() -> Callable[[], None]:
+    """distributed's loggers silenced (the faults they would log are said here, once each, in one line);
+    returns the function that restores their levels."""
+    import logging
+
+    names = ["distributed", *(name for name in list(logging.root.manager.loggerDict) if name.startswith("distributed."))]
+    loggers = [logging.getLogger(name) for name in names]
+    levels = [logger.level for logger in loggers]
+    for logger in loggers:
+        logger.setLevel(logging.CRITICAL + 1)
+
+    def restore() -> None:
+        for logger, level in zip(loggers, levels):
+            logger.setLevel(level)
+
+    return restore
+
+
+@contextlib.contextmanager
+def _quiet_distributed():
+    restore = silence_distributed()
+    try:
+        yield
+    finally:
+        restore()
+
+
+def _to_stderr(line: str) -> None:
+    print(line, file=sys.stderr, flush=True)
 
 
 def import_distributed():
@@ -216,18 +502,32 @@ def import_distributed():
 BACKENDS = {"serial": SerialBackend, "processes": ProcessBackend, "dask": DaskBackend}
 
 
-def make_backend(workers: int | None = None, scheduler: Any = None):
-    """The backend for these arguments: ``scheduler`` (an address or a Client) -> Dask; else ``workers == 1``
-    -> serial; else a local process pool of ``workers`` (default: every CPU).  Both given is an error.
-    Use it as a context manager (``with make_backend(...) as backend``): a pool is kept until it closes."""
+def check_backend(workers: int | None = None, scheduler: Any = None, worker_timeout: float | None = None) -> None:
+    """The arguments of :func:`make_backend` checked (SceneError naming the argument), nothing contacted."""
+    if scheduler is None:
+        check_workers(workers)
+        if worker_timeout is not None:
+            raise SceneError("worker_timeout", "is the wait for the workers of a Dask cluster: give scheduler too")
+        return
+    if workers is not None:
+        raise SceneError("workers", "give either workers (a local pool) or a scheduler (a Dask cluster), not both")
+    check_scheduler(scheduler)
+    check_worker_timeout(worker_timeout)
+
+
+def make_backend(workers: int | None = None, scheduler: Any = None, worker_timeout: float | None = None):
+    """The backend for these arguments: ``scheduler`` (an address or a Client) -> Dask (``worker_timeout``:
+    :class:`DaskBackend`); else ``workers == 1`` -> serial; else a local process pool of ``workers``
+    (default: every CPU).  Both given is an error.  Use it as a context manager (``with make_backend(...) as
+    backend``): a pool is kept, a client open, until it closes."""
+    check_backend(workers, scheduler, worker_timeout)
     if scheduler is not None:
-        if workers is not None:
-            raise SceneError("workers", "give either workers (a local pool) or a scheduler (a Dask cluster), "
-                                        "not both")
-        return DaskBackend(scheduler)
+        return DaskBackend(scheduler, worker_timeout=worker_timeout)
     workers = check_workers(workers)
     return SerialBackend() if workers == 1 else ProcessBackend(workers)
 
 
-__all__ = ["BACKENDS", "SerialBackend", "ProcessBackend", "DaskBackend", "make_backend", "batch_size", "in_flight",
-           "default_workers", "check_workers", "import_distributed", "exit_with_parent", "local_pool"]
+__all__ = ["BACKENDS", "SerialBackend", "ProcessBackend", "DaskBackend", "make_backend", "check_backend", "batch_size",
+           "in_flight", "default_workers", "check_workers", "check_scheduler", "check_worker_timeout", "connect",
+           "close_quietly", "silence_distributed", "import_distributed", "exit_with_parent", "local_pool",
+           "CONNECT_TIMEOUT", "WORKER_TIMEOUT", "CLUSTER_POLL"]

@@ -26,7 +26,7 @@ from typing import Any, Callable, Iterator, Sequence
 import numpy as np
 
 from ..engine.accuracy import SolverSettings
-from ..errors import SceneError
+from ..errors import ClusterError, SceneError
 from ..scene import Scene
 
 #: Failed points a summary lists (``table=False``; ``recoil sweep --json``): the first ones in grid order.
@@ -38,7 +38,8 @@ PROBE_POINTS = 4
 def run_sweep(scene: Scene, params, *, end_time: float = 10.0, accuracy: str | SolverSettings = "standard",
               workers: int | None = None, scheduler=None, out=None, progress=True,
               stop_when_final: Sequence[str] = (), impact_threshold: float = 1000.0,
-              batch_size: int | None = None, large: bool = False, table: bool = True, announce=None):
+              batch_size: int | None = None, large: bool = False, table: bool = True, announce=None,
+              worker_timeout: float | None = None):
     """Simulate ``scene`` at every point of the grid of ``params`` and return the table (a pandas DataFrame).
 
     ``params``: dotted scene key -> values (a sequence, or a text spec ``"100,500,1000"`` /
@@ -57,7 +58,10 @@ def run_sweep(scene: Scene, params, *, end_time: float = 10.0, accuracy: str | S
 
     ``workers``: a local process pool of that many processes (default: every CPU; 1 runs here);
     ``scheduler``: a Dask scheduler address ``"tcp://HOST:PORT"`` or a ``dask.distributed.Client``
-    instead (the ``cluster`` extra).  Results are identical whichever runs them.
+    instead (the ``cluster`` extra).  Results are identical whichever runs them.  A fault of the cluster -- an
+    address that does not answer (within 10 s), a scheduler lost mid-sweep, no worker for ``worker_timeout``
+    seconds (default 60; a line on stderr says it is waiting) -- raises
+    :class:`~mbs_models.errors.ClusterError` saying how many rows are kept in ``out`` (a resume runs the rest).
 
     ``out``: a ``.csv`` (or, with pyarrow, ``.parquet``) file; rows are written as they finish and, at
     the end, the file holds the table in grid order.  If ``out`` already holds rows of the same sweep, only
@@ -95,10 +99,7 @@ def run_sweep(scene: Scene, params, *, end_time: float = 10.0, accuracy: str | S
     warn_unit_slips(scene, grid=dict(zip(grid.keys, grid.values)))  # to the caller of run_sweep
     if batch_size is not None and (isinstance(batch_size, bool) or not isinstance(batch_size, int) or batch_size < 1):
         raise SceneError("batch_size", f"must be a whole number >= 1, got {batch_size!r}")
-    if scheduler is None:
-        _backends.check_workers(workers)
-    elif workers is not None:
-        _backends.make_backend(workers, scheduler)  # the error: not both
+    _backends.check_backend(workers, scheduler, worker_timeout)
     if not table and out is None:
         raise SceneError("table", "table=False keeps the table in its file only: give out= as well")
     params_columns, metrics = list(grid.keys), metric_columns(scene)
@@ -114,7 +115,7 @@ def run_sweep(scene: Scene, params, *, end_time: float = 10.0, accuracy: str | S
     if not pending:
         backend = _backends.SerialBackend()
     elif scheduler is not None:
-        backend = _backends.make_backend(None, scheduler)
+        backend = _backends.make_backend(None, scheduler, worker_timeout)
     else:   # a pool of no more workers than tasks
         requested = _backends.check_workers(workers)
         tasks = math.ceil(pending / (batch_size or _backends.batch_size(pending, requested)))
@@ -137,6 +138,9 @@ def run_sweep(scene: Scene, params, *, end_time: float = 10.0, accuracy: str | S
             for batch in backend.run(evaluate_batch, _tasks(scene, settings, grid, missing, size)):
                 sink.add(batch)
                 bar(len(batch))
+        except ClusterError as exc:   # the rows so far are kept: say how many, and where
+            sink.abandon()
+            raise _stopped(exc, sink.resumed + sink.run, grid.size, out) from None
         except BaseException:
             sink.abandon()
             raise
@@ -144,6 +148,15 @@ def run_sweep(scene: Scene, params, *, end_time: float = 10.0, accuracy: str | S
             if bar is not None:
                 bar.close()
     return sink.result(table)
+
+
+def _stopped(error: ClusterError, rows: int, points: int, out) -> ClusterError:
+    if out is None:
+        kept = "its rows are lost (no out= file to keep them)"
+    else:
+        kept = f"the {rows:,} rows are in {out}" if rows else f"no row is in {out}"
+        kept += ": run the same sweep again to resume"
+    return ClusterError(f"{error} after {rows:,} of {points:,} points; {kept}")
 
 
 def _settings_record(scene: Scene, settings) -> dict:

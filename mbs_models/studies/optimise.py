@@ -47,7 +47,7 @@ from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
-from ..errors import SceneError
+from ..errors import ClusterError, SceneError
 from ..scene import Scene
 
 #: Columns of the history added to the sweep's row: evaluation number, generation (0: the initial
@@ -352,7 +352,8 @@ def optimise(scene: Scene, bounds: Mapping[str, tuple[float, float]], minimise: 
              constraints: Sequence[str | Constraint] = (), *, end_time: float = 10.0,
              accuracy: str = "standard", stop_when_final: bool = True, seed: int = 1, popsize: int = 10,
              maxiter: int = 30, tol: float = 1e-4, init: str = "latinhypercube", workers: int | None = None,
-             scheduler: Any = None, progress: Callable[[str], None] | None = None) -> OptimisationResult:
+             scheduler: Any = None, progress: Callable[[str], None] | None = None,
+             worker_timeout: float | None = None) -> OptimisationResult:
     """Minimise the metric ``minimise`` of ``scene`` over the fields in ``bounds`` (dotted key ->
     (low, high), SI units), subject to ``constraints`` (``"metric<=value"``, ``"metric>=value"`` or
     :class:`Constraint`).
@@ -367,8 +368,10 @@ def optimise(scene: Scene, bounds: Mapping[str, tuple[float, float]], minimise: 
     Each point is simulated to ``end_time`` (s) at ``accuracy``; with ``stop_when_final`` (default) a run
     ends as soon as the objective's and the constraints' metrics are proven final (when they all can be:
     :func:`early_stop_metrics`).  ``workers``/``scheduler``: the sweep's backends (local processes,
-    default all CPUs; or a Dask scheduler address / Client).  See the module docstring for how
-    constraints and failed points are handled.
+    default all CPUs; or a Dask scheduler address / Client; ``worker_timeout``: seconds without a worker
+    before a Dask run stops, default 60).  A fault of the cluster (unreachable, scheduler lost, no worker) is
+    an error of the whole optimisation, :class:`~mbs_models.errors.ClusterError`, never a failed point.  See
+    the module docstring for how constraints and failed points are handled.
     """
     from scipy.optimize import NonlinearConstraint, differential_evolution
 
@@ -388,7 +391,7 @@ def optimise(scene: Scene, bounds: Mapping[str, tuple[float, float]], minimise: 
 
     keys = list(bounds)
     convergence_rows: list[dict[str, Any]] = []
-    with make_backend(workers, scheduler) as backend:
+    with make_backend(workers, scheduler, worker_timeout) as backend:
         evaluations = _Evaluations(scene, keys, settings, backend, minimise, constraints, progress)
         # rows of constraint_values: the solved flag (<= 0), then each metric within its limit
         nonlinear = NonlinearConstraint(evaluations.constraint_values,
@@ -404,10 +407,15 @@ def optimise(scene: Scene, bounds: Mapping[str, tuple[float, float]], minimise: 
                 "convergence": float(getattr(intermediate_result, "convergence", math.nan)),
                 **{k: float(v) for k, v in zip(keys, intermediate_result.x)}})
 
-        solution = differential_evolution(
-            evaluations.objective, list(bounds.values()), strategy="best1bin", maxiter=maxiter, popsize=popsize,
-            tol=tol, mutation=(0.5, 1.0), recombination=0.7, seed=seed, callback=callback, polish=False,
-            init=init, updating="deferred", workers=1, vectorized=True, constraints=(nonlinear,))
+        try:
+            solution = differential_evolution(
+                evaluations.objective, list(bounds.values()), strategy="best1bin", maxiter=maxiter,
+                popsize=popsize, tol=tol, mutation=(0.5, 1.0), recombination=0.7, seed=seed, callback=callback,
+                polish=False, init=init, updating="deferred", workers=1, vectorized=True, constraints=(nonlinear,))
+        except ClusterError as exc:
+            raise ClusterError(f"{exc} after {len(evaluations.rows)} evaluations (generation "
+                               f"{evaluations.generation}); the optimisation stopped, nothing of it is kept: "
+                               "run it again") from None
 
     history = pd.DataFrame(evaluations.rows)
     front = [*HISTORY_COLUMNS, *keys]
