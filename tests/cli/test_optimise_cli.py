@@ -49,6 +49,12 @@ def test_no_feasible_design_is_exit_1(tmp_path, capsys):
      "given twice"),
     (["--vary", "contact.gap=0:0.1", "--minimise", "max_barrel_displacement", "--popsize", "0"], "--popsize"),
     (["--vary", "contact.gap=0:0.1"], "--minimise"),
+    (["--vary", "contact.gap=0:0.1", "--minimise", "max_barrel_displacement", "--scheduler", "garbage"],
+     "--scheduler: must be a Dask scheduler address tcp://HOST:PORT"),
+    (["--vary", "contact.gap=0:0.1", "--minimise", "max_barrel_displacement", "--scheduler", "tcp://127.0.0.1:8786",
+      "--worker-timeout", "-1"], "--worker-timeout: must be a number of seconds > 0"),
+    (["--vary", "contact.gap=0:0.1", "--minimise", "max_barrel_displacement", "--worker-timeout", "5"],
+     "--worker-timeout: is the wait for the workers of a Dask cluster"),
 ])
 def test_bad_input_is_one_line_exit_2_and_writes_nothing(tmp_path, capsys, args, text):
     out = tmp_path / "never"
@@ -97,3 +103,16 @@ def test_a_barrel_mass_in_tonnes_warns_on_one_line(tmp_path, capsys):
           "--end-time", "0.05", "--accuracy", "draft", "--out", str(tmp_path / "o"), *SMALL])
     warned = [line for line in capsys.readouterr().err.splitlines() if "warning" in line]
     assert len(warned) == 1 and warned[0].startswith("recoil: warning: barrel.mass = 5.6 kg")
+
+
+def test_an_unreachable_scheduler_is_one_line_exit_1(tmp_path, capfd):
+    pytest.importorskip("dask.distributed")
+    import socket
+
+    with socket.socket() as probe:   # a port nobody listens on
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    assert main(["optimise", "model_i", "--vary", "contact.gap=0:0.1", "--minimise", "max_barrel_displacement",
+                 "--out", str(tmp_path / "o"), "--scheduler", f"tcp://127.0.0.1:{port}"]) == 1
+    assert capfd.readouterr().err == (f"recoil: error: cannot connect to the Dask scheduler at tcp://127.0.0.1:{port}: "
+                                      "connection refused (nothing listens on that port)\n")

@@ -78,12 +78,123 @@ def test_missing_param_or_out_exits_2(capsys):
     assert "--out" in capsys.readouterr().err
 
 
-def test_an_unreachable_scheduler_exits_2(tmp_path, capsys):
-    pytest.importorskip("dask.distributed")
+def _free_port() -> int:
+    """A local TCP port nobody listens on (bound, then released)."""
+    import socket
+
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+@pytest.mark.parametrize("address", ["garbage", "127.0.0.1:8786", "tcp://127.0.0.1", "tcp://127.0.0.1:0",
+                                     "http://127.0.0.1:8786"])
+def test_a_malformed_scheduler_address_exits_2_at_once(address, tmp_path, capfd):
     out = tmp_path / "s.csv"
+    assert main(["sweep", "model_i", "--param", "contact.gap=0", "--out", str(out), "--scheduler", address]) == 2
+    err = capfd.readouterr().err
+    assert err == (f"recoil: error: --scheduler: must be a Dask scheduler address tcp://HOST:PORT (or tls://HOST:PORT; "
+                   f"PORT 1-65535) or a dask.distributed.Client, got {address!r}\n")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_an_unreachable_scheduler_exits_1_with_one_line_and_writes_nothing(tmp_path, capfd):
+    pytest.importorskip("dask.distributed")
+    import gc
+
+    out, port = tmp_path / "s.csv", _free_port()
     assert main(["sweep", "model_i", "--param", "contact.gap=0", "--out", str(out),
-                 "--scheduler", "tcp://127.0.0.1:1"]) == 2
-    assert "--scheduler: cannot connect" in capsys.readouterr().err and not out.exists()
+                 "--scheduler", f"tcp://127.0.0.1:{port}"]) == 1
+    gc.collect()   # a client left half-made would print its __del__ traceback here
+    assert capfd.readouterr().err == (f"recoil: error: cannot connect to the Dask scheduler at tcp://127.0.0.1:{port}: "
+                                      "connection refused (nothing listens on that port)\n")
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (["--scheduler", "tcp://127.0.0.1:8786", "--worker-timeout", "0"], "--worker-timeout: must be a number of seconds > 0"),
+    (["--scheduler", "tcp://127.0.0.1:8786", "--worker-timeout", "nan"], "--worker-timeout: must be a number"),
+    (["--worker-timeout", "5"], "--worker-timeout: is the wait for the workers of a Dask cluster: give scheduler"),
+])
+def test_a_bad_worker_timeout_exits_2(argv, needle, tmp_path, capsys):
+    out = tmp_path / "s.csv"
+    assert main(["sweep", "model_i", "--param", "contact.gap=0", "--out", str(out), *argv]) == 2
+    assert needle in capsys.readouterr().err and not out.exists()
+
+
+# ---------------------------------------------------------------- a Dask cluster of processes, killed mid-sweep
+#: 300 points of model (i) (about 10 ms each): long enough to be killed mid-way on any machine
+KILLED_PARAMS = ["absorber.mass=100,400,1000", "contact.gap=0:0.1:100"]
+
+
+def _sweep_on(cluster, out, *extra):
+    """``recoil sweep`` of KILLED_PARAMS on ``cluster`` into ``out`` (a subprocess), once its file holds more than
+    12 rows (the probes are 4); the process, still running, and its arguments."""
+    import subprocess
+    import sys
+
+    from dask_processes import environment, wait_until
+
+    argv = ["sweep", "model_i", *[a for p in KILLED_PARAMS for a in ("--param", p)], "--out", str(out), "--end-time",
+            "1", "--accuracy", "draft"]
+    proc = subprocess.Popen([sys.executable, "-m", "mbs_models", *argv, "--scheduler", cluster.address, *extra],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=environment())
+    wait_until(lambda: proc.poll() is not None or out.exists() and out.read_bytes().count(b"\n") > 13, 300,
+               "13 rows in the table")
+    assert proc.poll() is None, "the sweep ended before it could be hit: " + proc.communicate()[1]
+    return proc, argv
+
+
+def _stopped(proc, out, reason: str) -> tuple[int, list[str]]:
+    """The sweep's exit code is 1, its stderr the announcement first and last one line, ``reason`` (a regex) and
+    how many rows the file keeps: as many as it holds, every one ok.  Returns that count and stderr's lines."""
+    _, err = proc.communicate(timeout=300)
+    lines = err.splitlines()
+    assert proc.returncode == 1, err
+    assert lines[0].startswith("sweep: 300 points (3 x 100)") and len(lines) >= 2, err
+    match = re.fullmatch(rf"recoil: error: {reason} after (\d+) of 300 points; the (\d+) rows are in "
+                         rf"{re.escape(str(out))}: run the same sweep again to resume", lines[-1])
+    assert match and match[1] == match[2], err
+    table = pd.read_csv(out)
+    assert len(table) == int(match[1]) and (table["status"] == "ok").all()
+    return int(match[1]), lines
+
+
+@pytest.mark.slow
+def test_a_scheduler_killed_mid_sweep_exits_1_keeps_the_rows_and_resumes_exactly(tmp_path):
+    """SIGKILL the Dask scheduler while rows are being written: one line (no traceback), exit 1, the rows kept;
+    the same sweep again gives exactly the uninterrupted table (wall times aside)."""
+    from dask_processes import dask_processes
+
+    from mbs_models import run_sweep
+
+    out = tmp_path / "s.csv"
+    with dask_processes(tmp_path) as cluster:
+        proc, argv = _sweep_on(cluster, out)
+        cluster.kill_scheduler()
+        rows, lines = _stopped(proc, out, re.escape(f"the Dask scheduler {cluster.address} was lost"))
+    assert len(lines) == 2 and 13 <= rows < 300   # no traceback, no log line of distributed's
+    assert main([*argv, "--workers", "1"]) == 0
+    expected = run_sweep(model_i(), {"absorber.mass": "100,400,1000", "contact.gap": "0:0.1:100"}, end_time=1.0,
+                         accuracy="draft", workers=1, progress=False)
+    resumed = pd.read_csv(out, keep_default_na=False, na_values=[""])
+    expected_text = pd.read_csv(io.StringIO(expected.to_csv(index=False)), keep_default_na=False, na_values=[""])
+    pd.testing.assert_frame_equal(resumed.drop(columns="wall_time"), expected_text.drop(columns="wall_time"))
+
+
+@pytest.mark.slow
+def test_every_worker_killed_mid_sweep_waits_says_so_then_exits_1_after_the_worker_timeout(tmp_path):
+    from dask_processes import dask_processes
+
+    out = tmp_path / "s.csv"
+    with dask_processes(tmp_path) as cluster:
+        proc, _ = _sweep_on(cluster, out, "--worker-timeout", "3")
+        cluster.kill_workers()
+        rows, lines = _stopped(proc, out, re.escape(f"no Dask worker has been available at {cluster.address} for "
+                                                    "3 s (the worker timeout)"))
+    assert 13 <= rows < 300
+    assert lines[1:-1] == [f"dask: waiting for a worker: the scheduler {cluster.address} has none; giving up after 3 s "
+                           "without one (the worker timeout)"]
 
 
 def test_run_set_changes_the_scene_and_says_so(capsys):

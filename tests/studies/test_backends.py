@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+import math
 import sys
+import time
 
 import pytest
 
-from mbs_models import SceneError
-from mbs_models.studies.backends import (BACKENDS, ProcessBackend, SerialBackend, batch_size, import_distributed,
+from mbs_models import ClusterError, SceneError
+from mbs_models.studies.backends import (BACKENDS, WORKER_TIMEOUT, DaskBackend, ProcessBackend, SerialBackend,
+                                         batch_size, check_scheduler, check_worker_timeout, import_distributed,
                                          in_flight, make_backend)
 
 
@@ -169,3 +172,140 @@ def test_dask_takes_tasks_as_results_are_read(dask_cluster):
         assert all(r >= 1 for r in first) and len(pulled) <= 6 + 4
         results.close()
         assert sorted(backend.run(abs, [-3, -1, -2])) == [1, 2, 3]
+
+
+# ================================================================================================ Dask's faults
+@pytest.mark.parametrize("address", ["tcp://127.0.0.1:8786", " tcp://node-7.cluster.example:8786 ", "tls://10.0.0.2:1",
+                                     "tcp://[::1]:65535", "inproc://192.0.2.2/1234/1"])
+def test_scheduler_addresses(address):
+    assert check_scheduler(address) == address.strip()
+
+
+@pytest.mark.parametrize("address", ["garbage", "", "127.0.0.1:8786", "tcp://127.0.0.1", "tcp://:8786",
+                                     "tcp://127.0.0.1:0", "tcp://127.0.0.1:65536", "udp://127.0.0.1:8786",
+                                     "tcp://127.0.0.1:8786/path", "tcp://a b:8786", "inproc://", 8786, True, None])
+def test_malformed_scheduler_addresses_are_bad_input(address):
+    with pytest.raises(SceneError) as info:
+        check_scheduler(address)
+    assert info.value.key == "scheduler" and "tcp://HOST:PORT" in info.value.message and repr(address) in info.value.message
+
+
+@pytest.mark.parametrize("seconds", [0, -1.0, math.nan, -math.inf, True, "60"])
+def test_bad_worker_timeouts(seconds):
+    with pytest.raises(SceneError) as info:
+        check_worker_timeout(seconds)
+    assert info.value.key == "worker_timeout"
+
+
+def test_worker_timeout_default_and_no_limit():
+    assert check_worker_timeout(None) == WORKER_TIMEOUT == 60.0
+    assert check_worker_timeout(math.inf) == math.inf and check_worker_timeout(2) == 2.0
+
+
+def test_a_worker_timeout_without_a_scheduler_is_refused():
+    with pytest.raises(SceneError) as info:
+        make_backend(workers=2, worker_timeout=10.0)
+    assert info.value.key == "worker_timeout"
+
+
+def _free_port() -> int:
+    import socket
+
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+def _no_leftover_client(capfd) -> None:
+    """No Client half-made and left to its __del__ (which prints a traceback after a 20 s wait)."""
+    import gc
+
+    gc.collect()
+    assert "Exception ignored" not in capfd.readouterr().err
+
+
+def test_a_refused_connection_is_a_cluster_error_at_once(capfd):
+    """Refused: said at once, not after the connect timeout (Dask itself retries a refused connection until then)."""
+    import_distributed()
+    port, start = _free_port(), time.monotonic()
+    with pytest.raises(ClusterError) as info:
+        DaskBackend(f"tcp://127.0.0.1:{port}", connect_timeout=120.0)
+    assert time.monotonic() - start < 60.0
+    assert str(info.value) == (f"cannot connect to the Dask scheduler at tcp://127.0.0.1:{port}: connection refused "
+                               "(nothing listens on that port)")
+    _no_leftover_client(capfd)
+
+
+def test_an_unknown_host_is_a_cluster_error():
+    import_distributed()
+    with pytest.raises(ClusterError, match="unknown host 'no-such-host.invalid'"):
+        DaskBackend("tcp://no-such-host.invalid:8786")
+
+
+@pytest.mark.parametrize("scheme, reason", [("tcp", "no Dask scheduler answered within 1 s"), ("tls", "TLS")])
+def test_a_listener_that_is_no_dask_scheduler_is_a_cluster_error_within_the_timeout(scheme, reason, capfd):
+    """A port that accepts connections and never answers (Dask's own client waits far longer than its timeout
+    there), or TLS without its configuration."""
+    import socket
+
+    import_distributed()
+    with socket.socket() as listener:
+        listener.bind(("127.0.0.1", 0))
+        listener.listen(8)   # connections complete in the backlog; nothing is ever read or written
+        address = f"{scheme}://127.0.0.1:{listener.getsockname()[1]}"
+        with pytest.raises(ClusterError) as info:
+            DaskBackend(address, connect_timeout=1.0)
+    assert str(info.value).startswith(f"cannot connect to the Dask scheduler at {address}: ")
+    assert reason in str(info.value)
+    _no_leftover_client(capfd)
+
+
+def test_a_workers_address_is_not_a_scheduler(dask_cluster):
+    worker = next(iter(dask_cluster.scheduler_info["workers"]))
+    with pytest.raises(ClusterError) as info:
+        DaskBackend(worker)
+    assert str(info.value) == (f"cannot connect to the Dask scheduler at {worker}: what answers is not a Dask scheduler "
+                               "(it is a Worker)")
+
+
+def test_no_worker_for_the_worker_timeout_is_a_cluster_error_said_while_waiting(workerless_dask_cluster):
+    address, said = workerless_dask_cluster.scheduler_address, []
+    with DaskBackend(address, worker_timeout=1.0, say=said.append) as backend:
+        assert backend.workers == 1   # none: as if one, for the batch sizes
+        with pytest.raises(ClusterError) as info:
+            list(backend.run(abs, [-1, -2]))
+    assert str(info.value) == f"no Dask worker has been available at {address} for 1 s (the worker timeout)"
+    assert said == [f"dask: waiting for a worker: the scheduler {address} has none; giving up after 1 s without one "
+                    "(the worker timeout)"]
+
+
+def test_workers_that_come_while_waiting_take_the_tasks(workerless_dask_cluster):
+    cluster, said = workerless_dask_cluster, []
+
+    def say(line):
+        said.append(line)
+        if line.startswith("dask: waiting"):
+            cluster.scale(1)
+
+    with DaskBackend(cluster.scheduler_address, worker_timeout=math.inf, say=say) as backend:
+        assert sorted(backend.run(abs, [-1, -2, -3])) == [1, 2, 3]
+    assert said == [f"dask: waiting for a worker: the scheduler {cluster.scheduler_address} has none",
+                    f"dask: the scheduler {cluster.scheduler_address} has workers again; going on"]
+
+
+def test_a_task_that_kills_its_workers_is_a_cluster_error():
+    """Dask gives a task up once its workers died running it (KilledWorker; here after the first death): an
+    error of the run, not of the task."""
+    import os
+
+    import dask
+
+    distributed = import_distributed()
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}), \
+            distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                     dashboard_address=None) as cluster, \
+            DaskBackend(cluster.scheduler_address) as backend:
+        with pytest.raises(ClusterError) as info:
+            list(backend.run(os._exit, [1]))
+    assert str(info.value).startswith("Dask workers kept dying while running one task (killed, out of memory?), "
+                                      f"and the scheduler {cluster.scheduler_address} gave it up: ")

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from mbs_models import model_i, simulate
-from mbs_models.errors import SceneError, SimulationError
+from mbs_models.errors import ClusterError, SceneError, SimulationError
 from mbs_models.studies import point
 from mbs_models.studies.optimise import (Constraint, early_stop_metrics, optimise, parse_bound, parse_constraint)
 
@@ -124,6 +124,18 @@ def test_dask_backend_gives_the_same_points():
     assert remote.settings["backend"] == "dask"
     columns = ["contact.gap", "max_barrel_displacement"]
     assert remote.history[columns].equals(serial.history[columns])
+
+
+def test_a_cluster_without_workers_stops_the_whole_optimisation(workerless_dask_cluster):
+    """A fault of the cluster is an error of the optimisation, not a failed (infeasible) point."""
+    address, said = workerless_dask_cluster.scheduler_address, []
+    with pytest.raises(ClusterError) as info:
+        optimise(model_i(1000.0, 0.0), BOUNDS, "max_barrel_displacement", seed=3, popsize=4, maxiter=1,
+                 scheduler=address, worker_timeout=1.0, progress=said.append)
+    assert str(info.value) == (f"no Dask worker has been available at {address} for 1 s (the worker timeout) after 0 "
+                               "evaluations (generation 0); the optimisation stopped, nothing of it is kept: run it "
+                               "again")
+    assert said == []   # no generation was reported done
 
 
 def test_writes_history_plot_and_summary(tmp_path):

@@ -271,6 +271,23 @@ def test_a_dask_worker_killed_mid_sweep_loses_no_point(dask_cluster, tmp_path):
     _assert_file_holds(tmp_path / "k.csv", serial)
 
 
+def test_a_cluster_without_workers_stops_the_sweep_saying_what_the_file_keeps(workerless_dask_cluster, tmp_path,
+                                                                               capsys):
+    address, out = workerless_dask_cluster.scheduler_address, tmp_path / "w.csv"
+    with pytest.raises(mbs_models.ClusterError) as info:
+        run_sweep(model_i(), {"contact.gap": [0.0, 0.01]}, end_time=0.2, scheduler=address, worker_timeout=1.0,
+                  out=out, progress=False)
+    assert str(info.value) == (f"no Dask worker has been available at {address} for 1 s (the worker timeout) after 0 of "
+                               f"2 points; no row is in {out}: run the same sweep again to resume")
+    assert capsys.readouterr().err == (f"dask: waiting for a worker: the scheduler {address} has none; giving up after "
+                                       "1 s without one (the worker timeout)\n")
+    workerless_dask_cluster.scale(1)   # the same sweep again, with a worker: every point, each once
+    table = run_sweep(model_i(), {"contact.gap": [0.0, 0.01]}, end_time=0.2, scheduler=address, worker_timeout=1.0,
+                      out=out, progress=False)
+    pd.testing.assert_frame_equal(_values(table), _values(run_sweep(model_i(), {"contact.gap": [0.0, 0.01]},
+                                                                      end_time=0.2, workers=1, progress=False)))
+
+
 def test_a_tqdm_bar_on_a_terminal_only(capsys, monkeypatch):
     grid = {"contact.gap": [0.0, 0.01]}
     run_sweep(model_i(), grid, end_time=0.2, workers=1, batch_size=1)
