@@ -31,6 +31,15 @@ def wait_until(condition, timeout: float, what: str, every: float = 0.02) -> Non
         time.sleep(every)
 
 
+def free_port() -> int:
+    """A local TCP port nobody listens on (bound, then released)."""
+    import socket
+
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
 class DaskProcesses:
     """The scheduler's ``address``; :meth:`kill_scheduler`, :meth:`kill_workers`; :meth:`close` kills what is
     left.  The processes' output goes to ``scheduler.log`` and ``worker-N.log`` in ``directory``."""

@@ -107,11 +107,9 @@ def test_a_barrel_mass_in_tonnes_warns_on_one_line(tmp_path, capsys):
 
 def test_an_unreachable_scheduler_is_one_line_exit_1(tmp_path, capfd):
     pytest.importorskip("dask.distributed")
-    import socket
+    from dask_processes import free_port
 
-    with socket.socket() as probe:   # a port nobody listens on
-        probe.bind(("127.0.0.1", 0))
-        port = probe.getsockname()[1]
+    port = free_port()
     assert main(["optimise", "model_i", "--vary", "contact.gap=0:0.1", "--minimise", "max_barrel_displacement",
                  "--out", str(tmp_path / "o"), "--scheduler", f"tcp://127.0.0.1:{port}"]) == 1
     assert capfd.readouterr().err == (f"recoil: error: cannot connect to the Dask scheduler at tcp://127.0.0.1:{port}: "

@@ -78,15 +78,6 @@ def test_missing_param_or_out_exits_2(capsys):
     assert "--out" in capsys.readouterr().err
 
 
-def _free_port() -> int:
-    """A local TCP port nobody listens on (bound, then released)."""
-    import socket
-
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
-
-
 @pytest.mark.parametrize("address", ["garbage", "127.0.0.1:8786", "tcp://127.0.0.1", "tcp://127.0.0.1:0",
                                      "http://127.0.0.1:8786"])
 def test_a_malformed_scheduler_address_exits_2_at_once(address, tmp_path, capfd):
@@ -102,7 +93,9 @@ def test_an_unreachable_scheduler_exits_1_with_one_line_and_writes_nothing(tmp_p
     pytest.importorskip("dask.distributed")
     import gc
 
-    out, port = tmp_path / "s.csv", _free_port()
+    from dask_processes import free_port
+
+    out, port = tmp_path / "s.csv", free_port()
     assert main(["sweep", "model_i", "--param", "contact.gap=0", "--out", str(out),
                  "--scheduler", f"tcp://127.0.0.1:{port}"]) == 1
     gc.collect()   # a client left half-made would print its __del__ traceback here

@@ -208,14 +208,6 @@ def test_a_worker_timeout_without_a_scheduler_is_refused():
     assert info.value.key == "worker_timeout"
 
 
-def _free_port() -> int:
-    import socket
-
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
-
-
 def _no_leftover_client(capfd) -> None:
     """No Client half-made and left to its __del__ (which prints a traceback after a 20 s wait)."""
     import gc
@@ -226,8 +218,10 @@ def _no_leftover_client(capfd) -> None:
 
 def test_a_refused_connection_is_a_cluster_error_at_once(capfd):
     """Refused: said at once, not after the connect timeout (Dask itself retries a refused connection until then)."""
-    import_distributed()
-    port, start = _free_port(), time.monotonic()
+    from dask_processes import free_port
+
+    pytest.importorskip("dask.distributed")
+    port, start = free_port(), time.monotonic()
     with pytest.raises(ClusterError) as info:
         DaskBackend(f"tcp://127.0.0.1:{port}", connect_timeout=120.0)
     assert time.monotonic() - start < 60.0
@@ -237,7 +231,7 @@ def test_a_refused_connection_is_a_cluster_error_at_once(capfd):
 
 
 def test_an_unknown_host_is_a_cluster_error():
-    import_distributed()
+    pytest.importorskip("dask.distributed")
     with pytest.raises(ClusterError, match="unknown host 'no-such-host.invalid'"):
         DaskBackend("tcp://no-such-host.invalid:8786")
 
@@ -248,7 +242,7 @@ def test_a_listener_that_is_no_dask_scheduler_is_a_cluster_error_within_the_time
     there), or TLS without its configuration."""
     import socket
 
-    import_distributed()
+    pytest.importorskip("dask.distributed")
     with socket.socket() as listener:
         listener.bind(("127.0.0.1", 0))
         listener.listen(8)   # connections complete in the backlog; nothing is ever read or written
@@ -300,7 +294,7 @@ def test_a_task_that_kills_its_workers_is_a_cluster_error():
 
     import dask
 
-    distributed = import_distributed()
+    distributed = pytest.importorskip("dask.distributed")
     with dask.config.set({"distributed.scheduler.allowed-failures": 0}), \
             distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, host="127.0.0.1",
                                      dashboard_address=None) as cluster, \
