@@ -1,9 +1,9 @@
 """The ``recoil`` command line.
 
 Exit codes: 0 success; 1 a simulation or check failed, or the Dask cluster of a run did; 2 bad input (one
-line on stderr naming the problem, never a traceback for user mistakes).  A :class:`~mbs_models.errors.UnitWarning` (an implausible
-magnitude, a contact that can never close: :mod:`mbs_models.engine.unit_slips`) is one line on stderr,
-``recoil: warning: ...``, and the command goes on.
+line on stderr naming the problem, never a traceback for user mistakes).  A
+:class:`~mbs_models.errors.UnitWarning` (an implausible magnitude, a contact that can never close:
+:mod:`mbs_models.engine.unit_slips`) is one line on stderr, ``recoil: warning: ...``, and the command goes on.
 """
 
 from __future__ import annotations

@@ -7,8 +7,9 @@ a grid of more than 10^6 points without ``--large``; a failing point is a row of
 ``error``) and the sweep goes on; running the same command again resumes (only the points not yet in the
 file run). On a Dask cluster (``--scheduler``) a malformed address exits 2; an address that does not
 answer, a scheduler lost mid-sweep or no worker for ``--worker-timeout`` seconds exits 1 with one line
-saying how many rows the file keeps (the same command resumes). Before the points run, one line on stderr says how many there are and about how long they take
-(measured on a few points spread over the grid: an estimate). The table stays in its file: memory does not
+saying how many rows the file keeps (the same command resumes). Before the points run, one line on stderr
+says how many there are and about how long they take (measured on a few points spread over the grid: an
+estimate). The table stays in its file: memory does not
 grow with the grid. ``--set KEY=VALUE`` (``recoil run``, ``recoil validate``) changes fields of the scene
 for one run, with the same keys.
 """

@@ -421,7 +421,8 @@ def _identity_type(address: str, timeout: float) -> str:
             answer[0] = _first_line(exc)
             return
         kind = reply.get("type") if isinstance(reply, dict) else None
-        answer[0] = kind if kind == "Scheduler" else f"what answers is not a Dask scheduler (it is a {kind or 'stranger'})"
+        answer[0] = (kind if kind == "Scheduler" else
+                     f"what answers is not a Dask scheduler (it is a {kind or 'stranger'})")
 
     with _quiet_distributed():
         thread = threading.Thread(target=ask, name="dask-identity", daemon=True)
@@ -462,7 +463,8 @@ def silence_distributed() -> Callable[[], None]:
     returns the function that restores their levels."""
     import logging
 
-    names = ["distributed", *(name for name in list(logging.root.manager.loggerDict) if name.startswith("distributed."))]
+    names = ["distributed",
+             *(name for name in list(logging.root.manager.loggerDict) if name.startswith("distributed."))]
     loggers = [logging.getLogger(name) for name in names]
     levels = [logger.level for logger in loggers]
     for logger in loggers:
@@ -507,7 +509,7 @@ def check_backend(workers: int | None = None, scheduler: Any = None, worker_time
     if scheduler is None:
         check_workers(workers)
         if worker_timeout is not None:
-            raise SceneError("worker_timeout", "is the wait for the workers of a Dask cluster: give scheduler too")
+            raise SceneError("worker_timeout", "is the wait for the workers of a Dask cluster: give a scheduler too")
         return
     if workers is not None:
         raise SceneError("workers", "give either workers (a local pool) or a scheduler (a Dask cluster), not both")

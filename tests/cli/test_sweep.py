@@ -105,9 +105,10 @@ def test_an_unreachable_scheduler_exits_1_with_one_line_and_writes_nothing(tmp_p
 
 
 @pytest.mark.parametrize("argv, needle", [
-    (["--scheduler", "tcp://127.0.0.1:8786", "--worker-timeout", "0"], "--worker-timeout: must be a number of seconds > 0"),
+    (["--scheduler", "tcp://127.0.0.1:8786", "--worker-timeout", "0"],
+     "--worker-timeout: must be a number of seconds > 0"),
     (["--scheduler", "tcp://127.0.0.1:8786", "--worker-timeout", "nan"], "--worker-timeout: must be a number"),
-    (["--worker-timeout", "5"], "--worker-timeout: is the wait for the workers of a Dask cluster: give scheduler"),
+    (["--worker-timeout", "5"], "--worker-timeout: is the wait for the workers of a Dask cluster: give a scheduler"),
 ])
 def test_a_bad_worker_timeout_exits_2(argv, needle, tmp_path, capsys):
     out = tmp_path / "s.csv"

@@ -187,7 +187,8 @@ def test_scheduler_addresses(address):
 def test_malformed_scheduler_addresses_are_bad_input(address):
     with pytest.raises(SceneError) as info:
         check_scheduler(address)
-    assert info.value.key == "scheduler" and "tcp://HOST:PORT" in info.value.message and repr(address) in info.value.message
+    assert info.value.key == "scheduler"
+    assert "tcp://HOST:PORT" in info.value.message and repr(address) in info.value.message
 
 
 @pytest.mark.parametrize("seconds", [0, -1.0, math.nan, -math.inf, True, "60"])
@@ -258,8 +259,8 @@ def test_a_workers_address_is_not_a_scheduler(dask_cluster):
     worker = next(iter(dask_cluster.scheduler_info["workers"]))
     with pytest.raises(ClusterError) as info:
         DaskBackend(worker)
-    assert str(info.value) == (f"cannot connect to the Dask scheduler at {worker}: what answers is not a Dask scheduler "
-                               "(it is a Worker)")
+    assert str(info.value) == (f"cannot connect to the Dask scheduler at {worker}: what answers is not a Dask "
+                               "scheduler (it is a Worker)")
 
 
 def test_no_worker_for_the_worker_timeout_is_a_cluster_error_said_while_waiting(workerless_dask_cluster):

@@ -277,8 +277,8 @@ def test_a_cluster_without_workers_stops_the_sweep_saying_what_the_file_keeps(wo
     with pytest.raises(mbs_models.ClusterError) as info:
         run_sweep(model_i(), {"contact.gap": [0.0, 0.01]}, end_time=0.2, scheduler=address, worker_timeout=1.0,
                   out=out, progress=False)
-    assert str(info.value) == (f"no Dask worker has been available at {address} for 1 s (the worker timeout) after 0 of "
-                               f"2 points; no row is in {out}: run the same sweep again to resume")
+    assert str(info.value) == (f"no Dask worker has been available at {address} for 1 s (the worker timeout) after "
+                               f"0 of 2 points; no row is in {out}: run the same sweep again to resume")
     assert capsys.readouterr().err == (f"dask: waiting for a worker: the scheduler {address} has none; giving up after "
                                        "1 s without one (the worker timeout)\n")
     workerless_dask_cluster.scale(1)   # the same sweep again, with a worker: every point, each once
