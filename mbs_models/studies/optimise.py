@@ -413,7 +413,7 @@ def optimise(scene: Scene, bounds: Mapping[str, tuple[float, float]], minimise: 
                 popsize=popsize, tol=tol, mutation=(0.5, 1.0), recombination=0.7, seed=seed, callback=callback,
                 polish=False, init=init, updating="deferred", workers=1, vectorized=True, constraints=(nonlinear,))
         except ClusterError as exc:
-            raise ClusterError(f"{exc} after {len(evaluations.rows)} evaluations (generation "
+            raise ClusterError(f"{exc} after {len(evaluations.rows):,} evaluations (generation "
                                f"{evaluations.generation}); the optimisation stopped, nothing of it is kept: "
                                "run it again") from None
 
