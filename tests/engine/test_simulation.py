@@ -393,3 +393,28 @@ def test_every_reported_extreme_ends_within_a_bound(name, key, value):
         except (SceneError, SimulationError) as error:
             assert str(error).strip() and "\n" not in str(error)
     assert time.perf_counter() - start < 60.0
+
+
+def test_solves_run_with_exudyns_throw_on_ctrl_c_and_restore_it(monkeypatch):
+    """Exudyn's default (False) only asks a solve to stop after its current step, which a step rejected for ever at
+    the minimum step size never ends (DESIGN.md, Exudyn notes); the engine's solves throw at once."""
+    import exudyn
+
+    import mbs_models.engine.simulation as engine
+
+    original, seen = engine._pre_step_function, []
+
+    def spying(*args):
+        function = original(*args)
+
+        def pre_step(mbs, t):
+            seen.append(exudyn.special.solver.throwErrorWithCtrlC)
+            return function(mbs, t)
+
+        pre_step.new_solve = function.new_solve
+        return pre_step
+
+    monkeypatch.setattr(engine, "_pre_step_function", spying)
+    before = exudyn.special.solver.throwErrorWithCtrlC
+    simulate(simplified_model(), 0.5)
+    assert seen and all(seen) and exudyn.special.solver.throwErrorWithCtrlC == before
