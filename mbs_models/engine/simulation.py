@@ -300,8 +300,13 @@ def _interrupted(error: BaseException) -> bool:
 
 def _budget_explanation(budget: StepBudget, settings: SolverSettings, assembly: Assembly, run: dict,
                         end_time: float) -> str:
-    """The SimulationError message of a solve the budget stopped, with what in the scene is that fast."""
-    return budget.explanation(settings.solver, run.get("end_time", end_time), time_scale_hint(assembly.mechanism))
+    """The SimulationError message of a solve the budget stopped, with what in the scene is that fast (the usual
+    hint, the chattering contact, where the estimates overflow on extreme values)."""
+    try:
+        hint = time_scale_hint(assembly.mechanism)
+    except (ArithmeticError, ValueError):
+        hint = None
+    return budget.explanation(settings.solver, run.get("end_time", end_time), hint)
 
 
 def _initial_accelerations(assembly: Assembly, t: float = 0.0) -> dict[str, float]:

@@ -144,10 +144,14 @@ def time_scale_hint(mechanism: Mechanism) -> str:
         fastest = scales[0]
         words.append(f"the fastest always-acting motion: {fastest.describe()} (at least "
                      f"{fastest.steps(1.0):.2g} steps per simulated second)")
+    keys = _table_keys(mechanism)
+    nonlinear = list(dict.fromkeys(keys.get(c.element, c.element) for c in mechanism.connectors
+                                   if not c.is_contact and c.always_acting_fields() == (None, None)))
     if contact is None:
-        words.append(("no linear spring or damper of the scene is that fast: " if len(words) == 0 else "")
-                     + "a nonlinear law (the recoil brake's v|v| at a small orifice, the cradle's friction band, a "
-                     "gas spring) or a value far outside its physical range can make the motion that stiff: check "
-                     "the values and their units")
+        where = f" (here: {', '.join(nonlinear)})" if nonlinear else ""
+        words.append(("no linear spring or damper of the scene is that fast: " if not words else "")
+                     + f"a nonlinear law{where} -- the recoil brake's v|v| at a small orifice, the cradle's friction "
+                     "band, a gas spring -- or a value far outside its physical range can make the motion that stiff: "
+                     "check the values and their units")
     text = "; ".join(words)
     return text[0].upper() + text[1:]

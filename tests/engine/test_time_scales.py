@@ -119,5 +119,6 @@ def test_the_hint_names_what_may_be_stiff():
     stiff = Mechanism(apply_overrides(simplified_model(), {"recoil_spring.stiffness": 1e11}))
     assert "recoil_spring.stiffness = 1e+11 N/m on 5600 kg gives a period of 0.0015 s" in time_scale_hint(stiff)
     plain = time_scale_hint(Mechanism(load_scene(scene_path("recoil_brake"))))
-    assert plain.startswith("No linear spring or damper of the scene is that fast") and "brake" in plain
+    assert plain.startswith("No linear spring or damper of the scene is that fast") and "(here: recoil_brake)" in plain
+    assert "(here: cradle)" in time_scale_hint(Mechanism(load_scene(scene_path("cradle"))))
     assert "chattering" in time_scale_hint(Mechanism(load_scene(scene_path("model_ii"))))
