@@ -19,6 +19,11 @@ Contract
   limit); an adaptive solver that stepped over a whole (grazing) contact is re-run with a smaller
   ``max_step`` (the result's ``settings`` say which); a solve whose energy balance is off by more
   than 10 % of the initial energy raises SimulationError.
+* Bounds (:mod:`mbs_models.engine.guard`, :mod:`mbs_models.engine.time_scales`): every adaptive solve has a
+  step budget and a cap on its stored samples (SimulationError once spent); a scene whose linear springs and
+  dampers alone need more steps than the budget, with more than :data:`MAX_ABSORBERS` absorbers, or split into
+  more than :data:`MAX_SEGMENTS` segments is refused before solving (SceneError naming the key); Ctrl-C during a
+  solve raises KeyboardInterrupt.
 * The Exudyn model is released after every run (no growth over thousands of runs); a
   :class:`~mbs_models.engine.reuse.Simulator` keeps it for the next scene of the same structure instead
   (:func:`simulate_with`), with bit-identical results.
@@ -574,9 +579,13 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
     Raises
     ------
     SceneError: an argument is invalid, or a fixed step is unsafe for the scene (the message names it
-        and gives the safe limit).
+        and gives the safe limit), or the run is beyond a bound (README, "Limits"): a spring or damper too
+        stiff for the step budget (the message names the key and the largest value that fits), more than
+        :data:`MAX_ABSORBERS` absorbers, more than :data:`MAX_SEGMENTS` segments.
     SimulationError: the solve failed, stopped early, produced non-finite values, stepped over a
-        contact with a fixed step, or does not balance energy (see :mod:`mbs_models.engine.stability`).
+        contact with a fixed step, does not balance energy (see :mod:`mbs_models.engine.stability`), or
+        spent its step budget or its cap on stored samples (:mod:`mbs_models.engine.guard`).
+    KeyboardInterrupt: Ctrl-C during the solve (at once, whatever the solver is doing).
 
     Warns
     -----
