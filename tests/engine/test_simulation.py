@@ -351,10 +351,10 @@ def test_a_run_split_into_too_many_segments_is_refused_naming_the_key(name, key,
 
 @pytest.mark.parametrize("key, value", [("recoil_brake.discharge_coefficient", 1e-30),
                                         ("recoil_brake.orifice_area", 1e-30),
-                                        ("recoil_brake.fluid_density", 1e300), ("absorber.damping", 1e30), ("absorber.stiffness", 1e19)])
+                                        ("recoil_brake.fluid_density", 1e300)])
 def test_a_brake_absurdly_stiff_fails_clearly_within_the_budget(key, value):
-    """Issue #20: these ran for ever (growing 9 MiB/s, deaf to Ctrl-C); now the budget's stall window stops them
-    (two solves of 20 000 steps at most) with a message pointing at nonlinear laws and extreme values."""
+    """Issue #20: these ran for ever (Ctrl-C ended them as a failed solve); now the budget's stall window stops them
+    (two solves of 20 000 steps at most) with a message pointing at the brake and extreme values."""
     from mbs_models import load_scene
     from mbs_models.scene.overrides import apply_overrides
     from mbs_models.scenes import scene_path
@@ -368,7 +368,8 @@ def test_a_brake_absurdly_stiff_fails_clearly_within_the_budget(key, value):
 REPORTED_EXTREMES = [("firing.muzzle_velocity", 1e30), ("recoil_spring.stiffness", 1e19),
                      ("cradle.friction_coefficient", 1e300), ("recoil_damper.recoil", 1e30),
                      ("recoil_brake.orifice_area", 1e-30), ("recoil_brake.discharge_coefficient", 1e-30),
-                     ("recoil_brake.fluid_density", 1e300), ("absorber.damping", 1e30), ("absorber.stiffness", 1e19)]
+                     ("recoil_brake.fluid_density", 1e300), ("absorber.damping", 1e30),
+                     ("absorber.stiffness", 1e19)]
 
 
 def _reported_extremes():
