@@ -202,6 +202,17 @@ class Connector:
         enters the quadratic form of the energy bounds."""
         return self.stiffness
 
+    def always_acting_fields(self) -> tuple[str | None, str | None]:
+        """The fields of the connector's scene table that set :attr:`linear_stiffness` and :attr:`linear_damping`
+        where the connector acts with them in every state (a linear spring, a linear damper), None where not.
+
+        The up-front time-scale check (:mod:`mbs_models.engine.time_scales`) counts and names them.  Exudyn's
+        linear spring-damper as it is: ``stiffness`` and ``damping`` (those it has); a subclass (a contact, a law
+        of its own, whose linearisation holds in some states only) none unless it says so."""
+        if type(self) is not Connector:
+            return None, None
+        return ("stiffness" if self.stiffness else None), ("damping" if self.damping else None)
+
     @property
     def first_step_limit(self) -> float:
         """Largest first step (s) an adaptive solve may take for this connector (default: inf, no limit).

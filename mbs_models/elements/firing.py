@@ -51,17 +51,35 @@ from .table import Rule, Table, check_number
 SCENE_DIRECTORY: contextvars.ContextVar[Path | None] = contextvars.ContextVar("scene_directory", default=None)
 
 
+#: Points a pulse's table may have at most: the solve restarts at every point (each a linear piece of the force,
+#: ~0.2 ms a restart), so 20 000 points cost some 5 s per shot.  A pressure curve sampled at 1 MHz over a 12 ms
+#: pulse has 12 000; the shipped example 4, the tests up to 401.
+MAX_PULSE_POINTS = 20_000
+
+
+def _too_many_points(key: str, what: str) -> SceneError:
+    return SceneError(key, f"{what} more than {MAX_PULSE_POINTS} points (the solve restarts at every point): "
+                           "resample the curve (a breech force needs a few hundred)")
+
+
 def _number_list(key: str, values, rule: Rule) -> tuple[float, ...]:
     if isinstance(values, (str, bytes)) or not isinstance(values, (list, tuple)):
         raise SceneError(key, f"must be a list of numbers, got {type(values).__name__}")
+    if len(values) > MAX_PULSE_POINTS:
+        raise _too_many_points(key, f"has {len(values)} points,")
     return tuple(check_number(f"{key}.{i}", v, rule) for i, v in enumerate(values))
 
 
 def read_pulse_file(path: Path, key: str) -> tuple[tuple[float, ...], tuple[float, ...]]:
     """(times s, forces N) from a CSV file of two columns ``time,force`` after one header line."""
+    rows = []
     try:
         with open(path, newline="", encoding="utf-8") as handle:
-            rows = [row for row in csv.reader(handle) if row and any(cell.strip() for cell in row)]
+            for row in csv.reader(handle):
+                if row and any(cell.strip() for cell in row):
+                    rows.append(row)
+                    if len(rows) > MAX_PULSE_POINTS + 1:  # the header and the points
+                        raise _too_many_points(key, f"{path} has")
     except (OSError, UnicodeDecodeError) as exc:
         raise SceneError(key, f"cannot read the pulse file {path}: {exc}") from None
     if len(rows) < 3:

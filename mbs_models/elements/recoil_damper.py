@@ -81,6 +81,10 @@ class RecoilDamperConnector(Connector):
         """The larger coefficient (N s/m): what the linearised mechanism uses."""
         return max(self.damper.recoil, self.damper.counter_recoil)
 
+    def always_acting_fields(self) -> tuple[str | None, str | None]:
+        """No stiffness; the larger coefficient's field (:attr:`linear_damping`): one of the two acts in every state."""
+        return None, ("recoil" if self.damper.recoil >= self.damper.counter_recoil else "counter_recoil")
+
 
 def add_recoil_damper(mbs, marker_ground, marker_barrel, damper: RecoilDamper,
                       user_functions: str = "symbolic") -> RecoilDamperConnector:

@@ -5,7 +5,8 @@
 * :mod:`.simulation` -- :func:`simulate`, the one entry point;
 * :mod:`.accuracy` -- solver settings and the accuracy presets;
 * :mod:`.stability` -- contact time scales, unsafe steps refused, stepped-over contacts, energy balance;
-* :mod:`.guard` -- the step budget of adaptive solves;
+* :mod:`.guard` -- the step budget and the cap on stored samples of adaptive solves;
+* :mod:`.time_scales` -- springs and dampers too stiff for the budget, refused before the solve;
 * :mod:`.final_metrics` -- the early stop once energy bounds prove the peak metrics final;
 * :mod:`.reach` -- contacts that can never close (a gap beyond the barrel's free-recoil travel).
 

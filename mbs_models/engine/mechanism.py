@@ -120,6 +120,12 @@ class Mechanism:
         return sorted(t for t in times if t > 0.0)
 
     @property
+    def sensor_count(self) -> int:
+        """Sensors the assembled system stores every step: position, velocity and acceleration of every body, and
+        the force of every connector that records it (:func:`~mbs_models.engine.assembly.assemble`)."""
+        return 3 * len(self.bodies) + sum(1 for c in self.connectors if c.records_force)
+
+    @property
     def masses(self) -> np.ndarray:
         """Body masses (kg) in body order."""
         return np.array([b.mass for b in self.bodies])

@@ -19,6 +19,11 @@ Contract
   limit); an adaptive solver that stepped over a whole (grazing) contact is re-run with a smaller
   ``max_step`` (the result's ``settings`` say which); a solve whose energy balance is off by more
   than 10 % of the initial energy raises SimulationError.
+* Bounds (:mod:`mbs_models.engine.guard`, :mod:`mbs_models.engine.time_scales`): every adaptive solve has a
+  step budget and a cap on its stored samples (SimulationError once spent); a scene whose linear springs and
+  dampers alone need more steps than the budget, with more than :data:`MAX_ABSORBERS` absorbers, or split into
+  more than :data:`MAX_SEGMENTS` segments is refused before solving (SceneError naming the key); Ctrl-C during a
+  solve raises KeyboardInterrupt.
 * The Exudyn model is released after every run (no growth over thousands of runs); a
   :class:`~mbs_models.engine.reuse.Simulator` keeps it for the next scene of the same structure instead
   (:func:`simulate_with`), with bit-identical results.
@@ -44,20 +49,25 @@ from .assembly import Assembly, assemble
 from .final_metrics import (ENERGY_SLACK, FINAL_METRICS, STOP_AT_REST, STOP_END_TIME, STOP_ENERGY_CHECK,
                             STOP_METRICS_FINAL, STOP_NO_BOUND, FinalityTracker, check_metric_names, dissipative,
                             largest_energy_rise)
-from .guard import StepBudget, step_budget
+from .guard import StepBudget, sample_cap
 from .mechanism import Mechanism
 from .unit_slips import warn_unit_slips
-from .rest import RestWatch
+from .rest import CHECK_INTERVAL, RestWatch
+from .time_scales import check_time_scales, time_scale_hint
 
 #: Longest simulated time accepted, in s.
 MAX_END_TIME = 1.0e4
+#: Most absorbers a scene may have: Exudyn's cost per step grows with the square of the bodies (measured ~0.5 ms
+#: a step at 100 absorbers, 37 ms at 1 000), and so do the energy bounds set up before the solve.
+MAX_ABSORBERS = 100
 #: Re-solves (with max_step / 4 each) when an adaptive solver stepped over a whole contact.
 MAX_CONTACT_RETRIES = 3
 #: The finality tracker (stop_when_final) is shown the state at every this-many-th step: an observed step's
 #: pre-step call (reading the state, the bounds) costs ~10 us inside a solve, a step ~5 us (README, cost
 #: section; scripts/bench_prestep.py).  Changing it changes when early stops happen (not bit-identical).
 OBSERVE_EVERY = 4
-#: Most output samples kept for fixed-step solvers (output is thinned beyond this).
+#: Most output samples kept for fixed-step solvers (output is thinned beyond this, and beyond
+#: :func:`~mbs_models.engine.guard.sample_cap` for a scene with many sensors).
 MAX_FIXED_STEP_SAMPLES = 1_000_000
 #: Explicit solvers whose last stage is the end-of-step state ("first same as last": the last row of the
 #: Butcher tableau is the weights and its node is 1; Exudyn 1.13's DOPRI5 and ODE23, CSolverExplicit.cpp).
@@ -71,6 +81,9 @@ FIRST_SAME_AS_LAST_SOLVERS = ("DOPRI5", "ODE23")
 def _check_arguments(scene: Scene, end_time: float, impact_threshold: float) -> None:
     if not isinstance(scene, Scene):
         raise SceneError("scene", f"must be a Scene, got {type(scene).__name__}")
+    if len(scene.absorbers) > MAX_ABSORBERS:
+        raise SceneError("absorber", f"the scene has {len(scene.absorbers)} absorbers, more than the {MAX_ABSORBERS} "
+                                     "a run accepts (the cost of a step grows with the square of their number)")
     if isinstance(end_time, bool) or not isinstance(end_time, (int, float)) or not math.isfinite(end_time) \
             or not 0.0 < end_time <= MAX_END_TIME:
         raise SceneError("end_time", f"must be a number of seconds in (0, {MAX_END_TIME:g}], got {end_time!r}")
@@ -157,7 +170,8 @@ def _pre_step_function(assembly: Assembly, budget: StepBudget | None, tracker: F
     needs, everything else is looked up once here: one step counter serves the budget (which it calls only
     at :attr:`~mbs_models.engine.guard.StepBudget.next_check`) and the tracker's cadence; the state is read
     only for the captures or an observed step, and passed on as it is where Exudyn's coordinates are the
-    bodies in body order (else reordered).
+    bodies in body order (else reordered).  With the budget alone (most adaptive solves) the function only
+    counts: one Python call, an increment and a comparison per step (~0.2 us; README, "Limits").
     """
     data = assembly.mbs.systemData
     read_positions, read_velocities = data.GetODE2Coordinates, data.GetODE2Coordinates_t
@@ -173,6 +187,15 @@ def _pre_step_function(assembly: Assembly, budget: StepBudget | None, tracker: F
     steps = 0  # calls so far (all segments of a run): the budget's step count and the tracker's cadence
     next_check = budget.next_check if budget is not None else math.inf
     solver = []  # Exudyn's time-integration state, cached on the first call of each solve
+
+    def count(mbs, t):  # the budget alone (every adaptive solve): the least a step can pay
+        nonlocal steps, next_check
+        steps += 1
+        if steps >= next_check:
+            if not budget.advance(steps, t):
+                raise _BudgetSpent(f"step budget spent at t = {t:.6g} s")
+            next_check = budget.next_check
+        return True
 
     def pre_step(mbs, t):
         nonlocal steps, next_check
@@ -201,8 +224,9 @@ def _pre_step_function(assembly: Assembly, budget: StepBudget | None, tracker: F
             return not observe(t, q, v)
         return not observe(t, [q[i] for i in order], [v[i] for i in order])
 
-    pre_step.new_solve = solver.clear  # a segmented run calls it before each segment's solve
-    return pre_step
+    function = count if budget is not None and not captures and observe is None else pre_step
+    function.new_solve = solver.clear  # a segmented run calls it before each segment's solve
+    return function
 
 
 def _solve(assembly: Assembly, settings: SolverSettings, end_time: float,
@@ -217,6 +241,9 @@ def _solve(assembly: Assembly, settings: SolverSettings, end_time: float,
     """
     mbs = assembly.mbs
     ss = exudyn_simulation_settings(settings, end_time, start_time)
+    kept = sample_cap(len(assembly.sensors))
+    if not settings.adaptive and ss.timeIntegration.numberOfSteps > kept:  # many sensors: fewer samples each
+        ss.solution.sensors.writePeriod = max(ss.solution.sensors.writePeriod, (end_time - start_time) / kept)
     first_step = min((c.first_step_limit for c in assembly.mechanism.connectors), default=math.inf)
     if settings.adaptive and first_step < settings.max_step:  # else Exudyn starts with max_step
         ss.timeIntegration.initialStepSize = first_step
@@ -224,8 +251,8 @@ def _solve(assembly: Assembly, settings: SolverSettings, end_time: float,
     run = {} if run is None else run
     if "budget" not in run:
         run["budget"] = None
-        if settings.adaptive and assembly.mechanism.contacts:
-            run["budget"] = StepBudget(step_budget(run.get("end_time", end_time)))
+        if settings.adaptive:  # every adaptive solve: bounded steps and stored samples (engine/guard.py)
+            run["budget"] = StepBudget.for_run(run.get("end_time", end_time), len(assembly.sensors))
         if run["budget"] is not None or tracker is not None or assembly.mechanism.capturing_contacts:
             run["pre_step"] = _pre_step_function(assembly, run["budget"], tracker)
             mbs.SetPreStepUserFunction(run["pre_step"])
@@ -234,18 +261,24 @@ def _solve(assembly: Assembly, settings: SolverSettings, end_time: float,
     budget = run["budget"]
     print_to_console = exudyn.config.printToConsole
     exudyn.config.printToConsole = False  # Exudyn's own failure banner; we raise with the reason instead
+    special = exudyn.special.solver
+    throw_with_ctrl_c = special.throwErrorWithCtrlC
+    special.throwErrorWithCtrlC = True  # Ctrl-C stops the solve at once, not after a step that may never end
     try:
         success = mbs.SolveDynamic(ss, solverType=solver_type)
     except Exception as exc:  # Exudyn wraps user-function exceptions in its own error types
+        if _interrupted(exc):
+            raise KeyboardInterrupt from None
         if budget is not None and budget.exhausted_at is not None:
-            raise _StepSizeStalled(budget.explanation(settings.solver, end_time)) from None
+            raise _StepSizeStalled(_budget_explanation(budget, settings, assembly, run, end_time)) from None
         message = " ".join(str(exc).split())
         raise SimulationError(f"Exudyn {settings.solver} failed: {message[:500]}") from exc
     finally:
         exudyn.config.printToConsole = print_to_console
+        special.throwErrorWithCtrlC = throw_with_ctrl_c
     iteration = mbs.sys["dynamicSolver"].it
     if budget is not None and budget.exhausted_at is not None:
-        raise _StepSizeStalled(budget.explanation(settings.solver, end_time))
+        raise _StepSizeStalled(_budget_explanation(budget, settings, assembly, run, end_time))
     if not success:
         raise SimulationError(f"Exudyn {settings.solver} reported failure at t = {iteration.currentTime:.6g} s")
     stopped_final = tracker is not None and tracker.done
@@ -253,6 +286,32 @@ def _solve(assembly: Assembly, settings: SolverSettings, end_time: float,
         raise SimulationError(f"Exudyn {settings.solver} stopped early at t = {iteration.currentTime:.6g} s "
                               f"of {end_time:g} s")
     return int(iteration.currentStepIndex), float(iteration.currentTime)
+
+
+def _interrupted(error: BaseException) -> bool:
+    """True if ``error`` (what Exudyn raised) stems from a KeyboardInterrupt: Ctrl-C during the solve, which Exudyn
+    reports as its own error (a failed user function, a SystemError) with the interrupt as the cause."""
+    seen, pending = set(), [error]
+    while pending:
+        error = pending.pop()
+        if error is None or id(error) in seen:
+            continue
+        if isinstance(error, KeyboardInterrupt):
+            return True
+        seen.add(id(error))
+        pending += [error.__cause__, error.__context__]
+    return False
+
+
+def _budget_explanation(budget: StepBudget, settings: SolverSettings, assembly: Assembly, run: dict,
+                        end_time: float) -> str:
+    """The SimulationError message of a solve the budget stopped, with what in the scene is that fast (the usual
+    hint, the chattering contact, where the estimates overflow on extreme values)."""
+    try:
+        hint = time_scale_hint(assembly.mechanism)
+    except (ArithmeticError, ValueError):
+        hint = None
+    return budget.explanation(settings.solver, run.get("end_time", end_time), hint)
 
 
 def _initial_accelerations(assembly: Assembly, t: float = 0.0) -> dict[str, float]:
@@ -277,6 +336,8 @@ def _initial_accelerations(assembly: Assembly, t: float = 0.0) -> dict[str, floa
             if exudyn.ComputeItemType.ODE2LHS in applies:
                 lhs[ltg] += np.asarray(mbs.ComputeItem(index, exudyn.ComputeItemType.ODE2LHS), dtype=float)
     except Exception as exc:  # a user function that raises at the initial state
+        if _interrupted(exc):
+            raise KeyboardInterrupt from None
         message = " ".join(str(exc).split())
         raise SimulationError(f"evaluating the forces at t = 0 failed: {message[:500]}") from exc
     rhs = -lhs
@@ -341,6 +402,28 @@ def _collect(assembly: Assembly, end_time: float, settings: SolverSettings,
 
 #: Steps at least per window where a load varies (a breech pulse): the step is limited to its length / this.
 STEPS_PER_LOAD_WINDOW = 40
+#: Segments a run may be split into at most (:func:`segment_plan`: one per point of a pulse's table per shot):
+#: each restarts the solver (~0.2 ms), so this many cost some 20-30 s.
+MAX_SEGMENTS = 100_000
+
+
+def _check_bounds(mechanism: Mechanism, settings: SolverSettings, end_time: float,
+                  tracker: FinalityTracker | None, rest: RestWatch | None) -> None:
+    """Refuse before solving (SceneError naming the scene key) a run split into more than :data:`MAX_SEGMENTS`
+    segments, or an adaptive one whose always-acting time scales need more steps than its budget
+    (:mod:`mbs_models.engine.time_scales`) over the time it surely integrates: the whole window, its first
+    :data:`~mbs_models.engine.rest.CHECK_INTERVAL` where it may stop at rest, nothing where it may stop once
+    its metrics are final (the budget still bounds it)."""
+    segments = 1 + sum(1 for t in mechanism.breakpoints if t < end_time)
+    if segments > MAX_SEGMENTS:
+        pulse = mechanism.scene.firing.pulse if mechanism.scene.firing is not None else None
+        key = "burst.shots" if pulse is None else f"firing.pulse.{'file' if pulse.file is not None else 'times'}"
+        raise SceneError(key, f"the run would be split into {segments} segments (the solve restarts at every shot "
+                              f"and every point of a pulse's table, for every shot), more than {MAX_SEGMENTS}: "
+                              "use a pulse table with fewer points or fewer shots, or a shorter end time")
+    if settings.adaptive and tracker is None:
+        horizon = end_time if rest is None else min(end_time, CHECK_INTERVAL)
+        check_time_scales(mechanism, StepBudget.for_run(end_time, mechanism.sensor_count), horizon)
 
 
 def segment_plan(mechanism: Mechanism, end_time: float, settings: SolverSettings) -> list[tuple[float, float, SolverSettings]]:
@@ -496,9 +579,13 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
     Raises
     ------
     SceneError: an argument is invalid, or a fixed step is unsafe for the scene (the message names it
-        and gives the safe limit).
+        and gives the safe limit), or the run is beyond a bound (README, "Limits"): a spring or damper too
+        stiff for the step budget (the message names the key and the largest value that fits), more than
+        :data:`MAX_ABSORBERS` absorbers, more than :data:`MAX_SEGMENTS` segments.
     SimulationError: the solve failed, stopped early, produced non-finite values, stepped over a
-        contact with a fixed step, or does not balance energy (see :mod:`mbs_models.engine.stability`).
+        contact with a fixed step, does not balance energy (see :mod:`mbs_models.engine.stability`), or
+        spent its step budget or its cap on stored samples (:mod:`mbs_models.engine.guard`).
+    KeyboardInterrupt: Ctrl-C during the solve (at once, whatever the solver is doing).
 
     Warns
     -----
@@ -509,6 +596,7 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
         balance is off by more than 1 % of the initial energy.
     """
     if isinstance(scene, Scene):  # anything else: simulate_with's SceneError
+        _check_arguments(scene, end_time, impact_threshold)  # before the warnings: nothing to warn of a refusal
         warn_unit_slips(scene, stacklevel=2)
     return simulate_with(FRESH_MODELS, scene, end_time, accuracy, user_functions=user_functions,
                          impact_threshold=impact_threshold, stop_when_final=stop_when_final, stop_at_rest=stop_at_rest)
@@ -546,10 +634,14 @@ def simulate_with(models: FreshModels, scene: Scene, end_time: float = 10.0,
     early_stop = bool(requested) and dissipative(scene)
     t_start = _time.perf_counter()
     attempt = 0
+    checked = False
     while True:
         mechanism = Mechanism(scene)  # fresh: contacts carry the onset capture of one solve
         tracker = FinalityTracker(mechanism, requested, impact_threshold) if early_stop else None
         rest = RestWatch.of(mechanism, rest_tolerance, float(end_time), tracker.bounds if tracker else None)
+        if not checked:  # runs the budget would stop, refused before solving (SceneError naming the key)
+            _check_bounds(mechanism, settings, float(end_time), tracker, rest)
+            checked = True
         assembly = models.acquire(scene, settings.user_functions, mechanism)
         t_assembled = _time.perf_counter()
         failed = True

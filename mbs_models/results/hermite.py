@@ -81,13 +81,24 @@ class HermiteStack:
         self._derivatives = slice(first_derivative, first_derivative + count)
         self.time, self.y, self.dy = table[0], table[self._values], table[self._derivatives]
 
-    def __call__(self, t) -> np.ndarray:
-        """Values at times ``t`` (s, any shape), the interval of each found by bisection."""
+    def __call__(self, t, quantities=None) -> np.ndarray:
+        """Values at times ``t`` (s, any shape), the interval of each found by bisection.
+
+        ``quantities``: indices of the quantities wanted (shape (len(quantities),) + the shape of ``t``), each
+        the same floats as in the full result; None: all of them.  Only the samples of those quantities are
+        gathered, so a call for a few quantities of a large stack costs what those few cost."""
         t = np.asarray(t, dtype=float)
         i = np.minimum(np.maximum(np.searchsorted(self.time, t, side="right") - 1, 0), len(self.time) - 2)
-        # take: the same gathers as indexing, several times faster along axis 1
-        before, after = self._table.take(i, axis=1), self._table.take(i + 1, axis=1)
-        values, derivatives = self._values, self._derivatives
+        if quantities is None:
+            # take: the same gathers as indexing, several times faster along axis 1
+            before, after = self._table.take(i, axis=1), self._table.take(i + 1, axis=1)
+            values, derivatives = self._values, self._derivatives
+        else:
+            wanted = np.asarray(quantities, dtype=np.intp)
+            rows = np.concatenate([[0], self._values.start + wanted, self._derivatives.start + wanted])
+            rows = rows.reshape((-1,) + (1,) * i.ndim)
+            before, after = self._table[rows, i[None]], self._table[rows, i[None] + 1]
+            values, derivatives = slice(1, 1 + len(wanted)), slice(1 + len(wanted), 1 + 2 * len(wanted))
         return _combine(before[0], after[0], t, before[values], after[values], before[derivatives],
                         after[derivatives])
 

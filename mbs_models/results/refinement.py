@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..elements.connector import GROUND
 from .nested_grids import first_true_search, run
 from .peaks import maxima_near_samples, run_argmax, run_bounds
 from .result import Impact
@@ -82,9 +83,11 @@ class _Rounds:
     """Searches over brackets, each bracket with the function its values come from, run in lockstep.
 
     A search is added with its groups of brackets: ``[(function, count), ...]`` in bracket order, each
-    ``function(x, v, t)`` of per-body positions (m), velocities (m/s) and times (s).  The functions are
-    elementwise in the times, so each is evaluated once per round on every run of neighbouring times
-    that it owns (one contact's peak and crossing brackets), whatever the searches they belong to.
+    ``function(x, v, t)`` of per-body positions (m), velocities (m/s) and times (s), with an attribute
+    ``bodies``: the names of the bodies it reads (:func:`_reading`).  The functions are elementwise in the
+    times, so each is evaluated once per round on every run of neighbouring times that it owns (one
+    contact's peak and crossing brackets), whatever the searches they belong to, on the interpolated state
+    of its own bodies only (a round's cost grows with the times asked for, not with times x bodies).
     """
 
     def __init__(self, interp):
@@ -103,11 +106,11 @@ class _Rounds:
             return []
 
         def evaluate(times, parts):
-            x, v = self.interp.state(times)
             values = np.empty(len(times))
             for function, span in _function_spans(self.groups, parts):
-                values[span] = function({n: a[span] for n, a in x.items()}, {n: a[span] for n, a in v.items()},
-                                        times[span])
+                # only the bodies the function reads: one contact's two, not every body at every contact's times
+                x, v = self.interp.state(times[span], function.bodies)
+                values[span] = function(x, v, times[span])
             return [values[part] for _, part in parts]
 
         return run(evaluate, self.searches)
@@ -132,9 +135,16 @@ def _function_spans(groups: list[list[tuple]], parts: list[tuple[int, slice]]) -
     return [(function, slice(start, stop)) for function, start, stop in spans]
 
 
+def _reading(function, connectors):
+    """``function`` with the attribute ``bodies``: the bodies (names, in order) at the ends of ``connectors``."""
+    function.bodies = tuple(dict.fromkeys(end for c in connectors for end in (c.a, c.b) if end != GROUND))
+    return function
+
+
 def contact_force_function(mechanism, connector):
     """``(x, v, t) -> F``: a connector's force (N) from per-body positions (m), velocities (m/s), times (s)."""
-    return lambda x, v, t: connector.force(mechanism.relative(connector, x), mechanism.relative(connector, v), t)
+    return _reading(lambda x, v, t: connector.force(mechanism.relative(connector, x),
+                                                    mechanism.relative(connector, v), t), [connector])
 
 
 def support_magnitude_function(mechanism):
@@ -149,7 +159,7 @@ def support_magnitude_function(mechanism):
             total = total + connector.support_sign * connector.force(d, rate, t)
         return np.abs(total)
 
-    return magnitude
+    return _reading(magnitude, ground)
 
 
 def _add_peak_searches(rounds: _Rounds, time: np.ndarray, groups: list[tuple]):
@@ -187,28 +197,75 @@ def _add_crossing_search(rounds: _Rounds, groups: list[tuple]):
     return lambda results: [results[index][a:b] for a, b in zip(bounds[:-1], bounds[1:])]
 
 
+#: Contact episodes refined together at most: their searches' grids are held at once (some 55 kB per episode),
+#: so a run with more episodes (a contact chattering over a long window) is refined in batches of this many,
+#: one after the other -- the same floats, a bounded memory.
+EPISODES_PER_BATCH = 1024
+
+
 def refine(mechanism, time: np.ndarray, forces: dict[str, np.ndarray], interp, contacts, threshold: float,
            support_sample: int | None = None) -> tuple[dict[str, Episodes], tuple[float, float] | None]:
     """Episodes of each contact in ``contacts`` (their sampled ``forces[name]``, N) and, if
-    ``support_sample`` is given, the refined maximum ``(value N, time s)`` of |S| near that sample."""
-    sampled, functions = [], []
+    ``support_sample`` is given, the refined maximum ``(value N, time s)`` of |S| near that sample.
+
+    The episodes are refined in batches of at most :data:`EPISODES_PER_BATCH` (every contact's in one batch
+    unless there are more): each bracket's arithmetic is the same in any batch, so the results are too."""
+    sampled = []
     for connector in contacts:
         force = forces[connector.name]
         first, last = run_bounds(force > 0.0)
-        sampled.append((connector, force, first, last, run_argmax(force, first, last)))
-        functions.append(contact_force_function(mechanism, connector))
+        sampled.append((connector, contact_force_function(mechanism, connector), force, first, last,
+                        run_argmax(force, first, last)))
+    parts: dict[str, list] = {connector.name: [] for connector in contacts}
+    support_peak = None
+    for batch in _batches(sampled, EPISODES_PER_BATCH):
+        refined, support = _refine_batch(time, interp, batch, threshold, support_sample, mechanism)
+        if support is not None:
+            support_peak, support_sample = support, None  # searched in the first batch
+        for (connector, *_), episodes in zip(batch, refined):
+            parts[connector.name].append(episodes)
+    episodes = {name: pieces[0] if len(pieces) == 1 else
+                Episodes(*(np.concatenate([getattr(e, f) for e in pieces]) for f in Episodes.__dataclass_fields__))
+                for name, pieces in parts.items()}
+    return episodes, support_peak
+
+
+def _batches(sampled: list, size: int) -> list[list]:
+    """``sampled`` (per contact: connector, function, force, first, last, k) cut into batches of at most
+    ``size`` episodes in all, each contact's episodes in order (a contact without episodes in the first)."""
+    batches, current, room = [], [], size
+    for connector, function, force, first, last, k in sampled:
+        start = 0
+        while True:
+            stop = min(len(first), start + room)
+            current.append((connector, function, force, first[start:stop], last[start:stop], k[start:stop]))
+            room -= stop - start
+            start = stop
+            if start >= len(first):
+                break
+            batches.append(current)
+            current, room = [], size
+    batches.append(current)
+    return batches
+
+
+def _refine_batch(time: np.ndarray, interp, sampled: list, threshold: float, support_sample: int | None,
+                  mechanism) -> tuple[list[Episodes], tuple[float, float] | None]:
+    """:func:`refine` of the episodes in ``sampled`` (per contact: connector, function, force, first, last, k),
+    all their searches in lockstep: the :class:`Episodes` of each entry and the support peak (or None)."""
+    functions = [function for _, function, *_ in sampled]
     rounds = _Rounds(interp)
-    peak_groups = [(function, k) for function, (_, _, _, _, k) in zip(functions, sampled)]
+    peak_groups = [(function, k) for _, function, _, _, _, k in sampled]
     if support_sample is not None:  # first: the contacts' peak and crossing brackets then neighbour
         peak_groups.insert(0, (support_magnitude_function(mechanism), np.array([support_sample])))
     read_peaks = _add_peak_searches(rounds, time, peak_groups)
     surely = []
-    for connector, force, first, last, k in sampled:
+    for _, _, force, first, last, k in sampled:
         sure = force[k] > threshold  # the peak is never below the sample: an impact, unless NaN
         surely.append((np.flatnonzero(sure & (first > 0)), np.flatnonzero(sure & (last < len(time) - 1))))
     read_crossings = _add_crossing_search(rounds, [
         (function, _crossing_brackets(time, first, last, opens, closes))
-        for function, (_, _, first, last, _), (opens, closes) in zip(functions, sampled, surely)])
+        for function, (_, _, _, first, last, _), (opens, closes) in zip(functions, sampled, surely)])
     results = rounds.run()
     peaks = read_peaks(results)
     support_peak = None
@@ -217,9 +274,9 @@ def refine(mechanism, time: np.ndarray, forces: dict[str, np.ndarray], interp, c
         support_peak = (float(values[0]), float(times[0]))
     crossings = read_crossings(results) if read_crossings is not None else [None] * len(sampled)
 
-    episodes: dict[str, Episodes] = {}
+    episodes: list[Episodes] = []
     lifted = []
-    for (connector, force, first, last, k), (peak, t_peak), (opens, closes), found in zip(
+    for (_, _, force, first, last, k), (peak, t_peak), (opens, closes), found in zip(
             sampled, peaks, surely, crossings):
         sample = force[k]
         peak = np.where(sample > peak, sample, peak)  # max(refined, sample): the refined one on ties
@@ -232,13 +289,13 @@ def refine(mechanism, time: np.ndarray, forces: dict[str, np.ndarray], interp, c
             end[closes[keep]] = found[len(opens):][keep]
         late = strong & (force[k] <= threshold)
         lifted.append((np.flatnonzero(late & (first > 0)), np.flatnonzero(late & (last < len(time) - 1))))
-        episodes[connector.name] = Episodes(first, last, k, peak, t_peak, start, end)
+        episodes.append(Episodes(first, last, k, peak, t_peak, start, end))
     late_rounds = _Rounds(interp)
     read_late = _add_crossing_search(late_rounds, [
         (function, _crossing_brackets(time, first, last, opens, closes))
-        for function, (_, _, first, last, _), (opens, closes) in zip(functions, sampled, lifted)])
+        for function, (_, _, _, first, last, _), (opens, closes) in zip(functions, sampled, lifted)])
     if read_late is not None:
-        for (connector, *_), (opens, closes), found in zip(sampled, lifted, read_late(late_rounds.run())):
-            episodes[connector.name].start[opens] = found[:len(opens)]
-            episodes[connector.name].end[closes] = found[len(opens):]
+        for refined, (opens, closes), found in zip(episodes, lifted, read_late(late_rounds.run())):
+            refined.start[opens] = found[:len(opens)]
+            refined.end[closes] = found[len(opens):]
     return episodes, support_peak

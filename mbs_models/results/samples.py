@@ -60,9 +60,15 @@ class Interpolant:
         return ({name: values[i] for i, name in enumerate(self.names)},
                 {name: values[n + i] for i, name in enumerate(self.names)})
 
-    def state(self, t) -> tuple[dict, dict]:
-        """Every body's position (m) and velocity (m/s) at times ``t`` (s, any shape)."""
-        return self._split(self._stack(t))
+    def state(self, t, bodies=None) -> tuple[dict, dict]:
+        """Every body's position (m) and velocity (m/s) at times ``t`` (s, any shape); with ``bodies`` (names),
+        only theirs (the same floats, at the cost of those bodies alone)."""
+        if bodies is None:
+            return self._split(self._stack(t))
+        index = [self.names.index(name) for name in bodies]
+        values = self._stack(t, index + [len(self.names) + k for k in index])
+        return ({name: values[j] for j, name in enumerate(bodies)},
+                {name: values[len(index) + j] for j, name in enumerate(bodies)})
 
     def at_fractions(self, fractions) -> tuple[dict, dict]:
         """Every body's position and velocity at ``t_i + f h_i``, shape (fractions, intervals) each."""

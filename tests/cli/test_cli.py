@@ -256,3 +256,45 @@ def test_scenes_lists_every_shipped_scene_with_its_name(capsys):
     for line, file in zip(capsys.readouterr().out.splitlines(), files):
         assert line.split()[0] == file.stem and f"  {file}  " in line  # a path may hold spaces
         assert line.endswith("  " + tomllib.loads(file.read_text())["name"])
+
+
+def _cpu_seconds(pid: int) -> float:
+    """User + system CPU time (s) of a running process (Linux /proc)."""
+    import os
+    from pathlib import Path
+
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def test_ctrl_c_stops_a_long_run_at_once_with_one_line_and_exit_130(tmp_path):
+    """Issue #20: a stiff spring over 300 s (millions of steps) is interrupted in its solve: exit 130 within a few
+    seconds, one line, no traceback, no CSV half-written."""
+    import os
+    import signal
+    import time
+    from pathlib import Path
+
+    if not Path(f"/proc/{os.getpid()}/stat").exists():
+        pytest.skip("needs /proc to know the child is solving")
+    csv = tmp_path / "histories.csv"
+    proc = subprocess.Popen([sys.executable, "-m", "mbs_models", "run", "simplified", "--set",
+                             "recoil_spring.stiffness=1e12", "--end-time", "300", "--no-stop-at-rest",
+                             "--csv", str(csv)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 120.0
+        while _cpu_seconds(proc.pid) < 1.5:  # a whole short run takes 0.3 s of CPU: it is solving
+            assert proc.poll() is None, proc.communicate()
+            assert time.monotonic() < deadline
+            time.sleep(0.05)
+        proc.send_signal(signal.SIGINT)
+        sent = time.monotonic()
+        out, err = proc.communicate(timeout=30)
+        waited = time.monotonic() - sent
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 130, (out, err)
+    assert err == "recoil: interrupted\n" and out == ""
+    assert waited < 5.0  # the solve does not run on to the end (a guard, not a speed test)
+    assert not csv.exists() and not list(tmp_path.iterdir())

@@ -387,3 +387,25 @@ def test_the_shots_agree_with_the_reference(case):
         if theirs["position_at_next_shot"] is not None:
             assert ours["position_at_next_shot"] == pytest.approx(theirs["position_at_next_shot"], abs=1e-8)
     assert engine.energy()["burst"]["work"] == pytest.approx(reference.work["burst"], rel=1e-7)
+
+
+def test_a_pulse_table_has_a_stated_limit_named_by_its_key(tmp_path, capsys):
+    """Each table point is a segment of the solve: beyond MAX_PULSE_POINTS the table is refused before anything
+    runs, one line naming the key (a 600 000-point table once crashed the process)."""
+    from mbs_models.elements.firing import MAX_PULSE_POINTS
+    from mbs_models.scene.io import mapping_to_toml
+
+    times, forces = breech_pressure_table(MAX_PULSE_POINTS)  # at the limit: accepted
+    assert len(scene_from_dict(pulse_mapping(times=list(times), forces=list(forces))).firing.pulse.table[0]) \
+        == MAX_PULSE_POINTS
+    times, forces = breech_pressure_table(MAX_PULSE_POINTS + 1)
+    with pytest.raises(SceneError) as info:
+        scene_from_dict(pulse_mapping(times=list(times), forces=list(forces)))
+    assert info.value.key == "firing.pulse.times" and f"more than {MAX_PULSE_POINTS} points" in info.value.message
+    (tmp_path / "breech.csv").write_text("time,force\n" + "".join(f"{t!r},{f!r}\n" for t, f in zip(times, forces)))
+    mapping = pulse_mapping()
+    mapping["firing"]["pulse"] = {"file": "breech.csv"}
+    (tmp_path / "scene.toml").write_text(mapping_to_toml(mapping))
+    assert main(["run", str(tmp_path / "scene.toml")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "firing.pulse.file" in err[0] and f"more than {MAX_PULSE_POINTS} points" in err[0]

@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import pytest
 
-from mbs_models import RecoilDamper, model_i, model_ii, simplified_model
+from mbs_models import RecoilDamper, load_scene, model_i, model_ii, simplified_model
 from mbs_models.engine.assembly import assemble
+from mbs_models.engine.mechanism import Mechanism
+from mbs_models.scenes import list_scenes, scene_path
 
 
 def _inventory(assembly):
@@ -70,3 +72,11 @@ def test_close_releases_the_model():
     assembly.close()
     assert assembly.mbs is None and assembly.system_container is None
     assembly.close()  # idempotent
+
+
+@pytest.mark.parametrize("name", list_scenes())
+def test_the_mechanism_counts_the_sensors_the_assembly_stores(name):
+    """The sample cap (engine/guard.py) is worked out before assembly from Mechanism.sensor_count."""
+    scene = load_scene(scene_path(name))
+    with assemble(scene) as assembly:
+        assert Mechanism(scene).sensor_count == len(assembly.sensors)

@@ -2,8 +2,8 @@
 
 import pytest
 
-from mbs_models.engine.guard import (MINIMUM_STEP_BUDGET, STALL_WINDOW_STEPS, STALL_WINDOW_TIME, StepBudget,
-                                     step_budget)
+from mbs_models.engine.guard import (MAX_STORED_VALUES, MINIMUM_STEP_BUDGET, STALL_WINDOW_STEPS, STALL_WINDOW_TIME,
+                                     StepBudget, sample_cap, step_budget)
 
 
 def test_budget_grows_with_end_time_and_has_a_floor():
@@ -59,3 +59,34 @@ def test_advancing_at_the_checkpoints_only_is_calling_at_every_step(max_steps, s
     assert not expected
     assert (checkpoints.steps, checkpoints.exhausted_at, checkpoints.stalled) == \
         (every.steps, every.exhausted_at, every.stalled)
+
+
+def test_the_sample_cap_divides_the_stored_values_among_the_sensors():
+    assert sample_cap(7) == MAX_STORED_VALUES // 7
+    assert sample_cap(3) * 3 <= MAX_STORED_VALUES < (sample_cap(3) + 1) * 3
+    assert sample_cap(0) == MAX_STORED_VALUES and sample_cap(10 * MAX_STORED_VALUES) == 1
+
+
+def test_a_run_gets_the_smaller_of_the_step_budget_and_the_sample_cap():
+    few = StepBudget.for_run(1.0, 3)  # 200 000 steps < 3.3 million samples: the step budget binds
+    assert (few.max_steps, few.capped) == (step_budget(1.0), False)
+    many = StepBudget.for_run(1000.0, 7)  # 5e7 steps > 1.4 million samples: the cap binds
+    assert (many.max_steps, many.capped) == (MAX_STORED_VALUES // 7, True)
+    assert StepBudget(10).max_steps == 10 and not StepBudget(10).capped
+
+
+def test_a_capped_budget_says_the_output_cap_stopped_it_and_what_to_change():
+    budget = StepBudget(100, stored_samples=3)
+    assert [budget(None, 0.1 * i) for i in range(1, 6)] == [True, True, True, False, False]
+    text = budget.explanation("DOPRI5", 10.0, "Hint.")
+    assert "cap of 3 samples" in text and "shorter window" in text and "step budget of" not in text
+    assert text.endswith(". Hint.")
+
+
+def test_the_explanation_ends_with_the_scene_s_hint_or_the_chattering_contact():
+    budget = StepBudget(2)
+    for i in range(1, 4):
+        budget(None, 0.1 * i)
+    assert budget.explanation("ODE23", 1.0, "The spring is stiff.").endswith("spent (mean step 0.15 s). "
+                                                                           "The spring is stiff.")
+    assert "chattering" in budget.explanation("ODE23", 1.0)

@@ -218,3 +218,217 @@ def test_other_solvers_keep_exudyns_end_of_step_accelerations():
     assert fixed.timeIntegration.explicit.computeEndOfStepAccelerations
     standard = exudyn_simulation_settings(solver_settings_for("standard"), 1.0)
     assert not standard.timeIntegration.explicit.computeEndOfStepAccelerations
+
+
+# ------------------------------------------------------------------ bounds (issue #20): every run ends
+
+
+def _contact_free_scenes():
+    from mbs_models import load_scene
+    from mbs_models.engine.mechanism import Mechanism
+    from mbs_models.scenes import list_scenes, scene_path
+
+    return [pytest.param(load_scene(scene_path(name)), id=name) for name in list_scenes()
+            if not Mechanism(load_scene(scene_path(name))).contacts]
+
+
+@pytest.mark.parametrize("scene", _contact_free_scenes())
+def test_the_budget_of_a_scene_without_contact_changes_no_result(scene, monkeypatch, assert_results_identical):
+    """Every adaptive solve now counts its steps in a pre-step function; without it (as before issue #20) every
+    contact-free shipped scene gives the same Result, bit for bit."""
+    import mbs_models.engine.simulation as engine
+
+    budgeted = simulate(scene, 3.0)
+    assert budgeted.steps > 0
+    monkeypatch.setattr(engine.StepBudget, "for_run", classmethod(lambda cls, end_time, sensors: None))
+    monkeypatch.setattr(engine, "check_time_scales", lambda *args: None)
+    assert_results_identical(budgeted, simulate(scene, 3.0))
+
+
+def test_a_scene_without_contact_is_stopped_by_the_step_budget_naming_its_stiff_spring(monkeypatch):
+    """The budget bounds contact-free solves too (a stiff spring the up-front check lets through, a budget of
+    500 steps for the 2000 this run takes); the message names what is fast."""
+    import mbs_models.engine.guard as guard
+    import mbs_models.engine.simulation as engine
+    from mbs_models.scene.overrides import apply_overrides
+
+    monkeypatch.setattr(guard, "MINIMUM_STEP_BUDGET", 500)
+    monkeypatch.setattr(guard, "STEPS_PER_SIMULATED_SECOND", 0)
+    monkeypatch.setattr(engine, "check_time_scales", lambda *args: None)
+    with pytest.raises(SimulationError) as info:
+        simulate(apply_overrides(simplified_model(), {"recoil_spring.stiffness": 1e11}), 1.0)
+    message = str(info.value)
+    assert "step budget of 500 steps" in message
+    assert "recoil_spring.stiffness = 1e+11 N/m on 5600 kg gives a period of 0.0015 s" in message
+
+
+def test_stored_samples_are_capped_and_a_run_beyond_the_cap_fails_saying_so(monkeypatch):
+    """Model (ii) stores seven sensors; with room for 200 samples a 2 s draft run (some 270 steps) fails naming the
+    cap, with room for 2000 it passes holding fewer samples than the cap."""
+    import mbs_models.engine.guard as guard
+
+    scene = model_ii(1000.0, 0.0)
+    monkeypatch.setattr(guard, "MAX_STORED_VALUES", 7 * 2000)
+    result = simulate(scene, 2.0, "draft")
+    assert 200 < len(result.time) <= 2000 and result.steps <= 2000
+    monkeypatch.setattr(guard, "MAX_STORED_VALUES", 7 * 200)
+    with pytest.raises(SimulationError, match="reached its cap of 200 samples"):
+        simulate(scene, 2.0, "draft")
+
+
+def test_a_fixed_step_run_with_many_sensors_is_thinned_to_the_cap(monkeypatch):
+    import mbs_models.engine.guard as guard
+
+    monkeypatch.setattr(guard, "MAX_STORED_VALUES", 3 * 500)  # the simplified model: three sensors
+    result = simulate(simplified_model(), 2.0, SolverSettings(solver="RK44", step=1e-3))  # 2000 steps
+    assert len(result.time) <= 501 and result.time[-1] == pytest.approx(2.0)
+
+
+def test_ctrl_c_during_a_solve_is_a_keyboard_interrupt_not_a_failed_solve(monkeypatch):
+    """Exudyn reports an interrupt inside the solve as its own error; simulate raises KeyboardInterrupt."""
+    import mbs_models.engine.simulation as engine
+
+    original = engine._pre_step_function
+
+    def interrupted_after_50_steps(*args):
+        function, calls = original(*args), []
+
+        def pre_step(mbs, t):
+            calls.append(t)
+            if len(calls) == 50:
+                raise KeyboardInterrupt
+            return function(mbs, t)
+
+        pre_step.new_solve = function.new_solve
+        return pre_step
+
+    monkeypatch.setattr(engine, "_pre_step_function", interrupted_after_50_steps)
+    for scene in (simplified_model(), model_ii(1000.0, 0.0)):
+        with pytest.raises(KeyboardInterrupt):
+            simulate(scene, 1.0)
+
+
+def test_an_error_caused_by_an_interrupt_is_recognised_down_its_chain():
+    from mbs_models.engine.simulation import _interrupted
+
+    try:
+        try:
+            raise KeyboardInterrupt
+        except KeyboardInterrupt as interrupt:
+            raise SystemError("returned a result with an exception set") from interrupt
+    except SystemError as error:
+        assert _interrupted(error)
+    assert not _interrupted(RuntimeError("a user function failed"))
+
+
+def test_too_many_absorbers_are_refused_before_anything_else(tmp_path, recwarn):
+    from mbs_models import load_scene
+    from mbs_models.engine.simulation import MAX_ABSORBERS
+
+    absorbers = "".join(f'[[absorber]]\nname = "a{i}"\nmass = 10.0\nmount = "ground"\nstiffness = 8100.0\n'
+                        f'damping = 2205.0\n[absorber.contact]\ngap = 5.0\nstiffness = 2.1e8\nexponent = 1.3\n'
+                        f'damping_factor = 0.6\n' for i in range(MAX_ABSORBERS + 1))
+    (tmp_path / "many.toml").write_text('version = 2\n[barrel]\nmass = 5600.0\n[firing]\nprojectile_mass = 6.86\n'
+                                        'muzzle_velocity = 564.0\n[recoil_spring]\nstiffness = 27500.0\n' + absorbers)
+    scene = load_scene(tmp_path / "many.toml")
+    with pytest.raises(SceneError) as info:
+        simulate(scene, 1.0)
+    assert info.value.key == "absorber" and f"{MAX_ABSORBERS + 1} absorbers" in info.value.message
+    assert not recwarn.list  # refused before the unit-slip warnings (5 m gaps never close) are worked out
+
+
+@pytest.mark.parametrize("name, key", [("breech_pulse", "firing.pulse.times"), ("burst", "burst.shots")])
+def test_a_run_split_into_too_many_segments_is_refused_naming_the_key(name, key, monkeypatch):
+    import mbs_models.engine.simulation as engine
+    from mbs_models import load_scene
+    from mbs_models.scenes import scene_path
+
+    monkeypatch.setattr(engine, "MAX_SEGMENTS", 2)  # the pulse has 4 points, the burst 3 shots
+    with pytest.raises(SceneError) as info:
+        simulate(load_scene(scene_path(name)), 3.0)
+    assert info.value.key == key and "segments" in info.value.message
+
+
+@pytest.mark.parametrize("key, value", [("recoil_brake.discharge_coefficient", 1e-30),
+                                        ("recoil_brake.orifice_area", 1e-30),
+                                        ("recoil_brake.fluid_density", 1e300)])
+def test_a_brake_absurdly_stiff_fails_clearly_within_the_budget(key, value):
+    """Issue #20: these ran for ever (Ctrl-C ended them as a failed solve); now the budget's stall window stops them
+    (two solves of 20 000 steps at most) with a message pointing at the brake and extreme values."""
+    from mbs_models import load_scene
+    from mbs_models.scene.overrides import apply_overrides
+    from mbs_models.scenes import scene_path
+
+    with pytest.raises(SimulationError) as info:
+        simulate(apply_overrides(load_scene(scene_path("recoil_brake")), {key: value}), 0.5)
+    assert "step size collapsed" in str(info.value) and "recoil brake's v|v|" in str(info.value)
+
+
+#: The extreme values issue #20 reported (each ran without end, or ended in an unclear error).
+REPORTED_EXTREMES = [("firing.muzzle_velocity", 1e30), ("recoil_spring.stiffness", 1e19),
+                     ("cradle.friction_coefficient", 1e300), ("recoil_damper.recoil", 1e30),
+                     ("recoil_brake.orifice_area", 1e-30), ("recoil_brake.discharge_coefficient", 1e-30),
+                     ("recoil_brake.fluid_density", 1e300), ("absorber.damping", 1e30),
+                     ("absorber.stiffness", 1e19)]
+
+
+def _reported_extremes():
+    """Each reported value on each shipped scene that has its table."""
+    from mbs_models import load_scene
+    from mbs_models.scenes import list_scenes, scene_path
+
+    cases = []
+    for name in list_scenes():
+        scene = load_scene(scene_path(name))
+        tables = {key for key, _ in scene.tables()}
+        cases += [pytest.param(name, key, value, id=f"{name}-{key}") for key, value in REPORTED_EXTREMES
+                  if key.split(".")[0] in tables]
+    return cases
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name, key, value", _reported_extremes())
+def test_every_reported_extreme_ends_within_a_bound(name, key, value):
+    """Each value issue #20 reported, on each shipped scene that has its table: a result, a SceneError (the scene's or
+    before the solve) or a one-line SimulationError -- never a run without end (a generous 60 s, a guard, not a speed test)."""
+    import time
+    import warnings
+
+    from mbs_models import load_scene
+    from mbs_models.scene.overrides import apply_overrides
+    from mbs_models.scenes import scene_path
+
+    start = time.perf_counter()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:  # the scene itself may refuse the value (SceneError)
+            result = simulate(apply_overrides(load_scene(scene_path(name)), {key: value}), 0.5)
+            assert np.all(np.isfinite(result.time))
+        except (SceneError, SimulationError) as error:
+            assert str(error).strip() and "\n" not in str(error)
+    assert time.perf_counter() - start < 60.0
+
+
+def test_solves_run_with_exudyns_throw_on_ctrl_c_and_restore_it(monkeypatch):
+    """Exudyn's default (False) only asks a solve to stop after its current step, which a step rejected for ever at
+    the minimum step size never ends (DESIGN.md, Exudyn notes); the engine's solves throw at once."""
+    import exudyn
+
+    import mbs_models.engine.simulation as engine
+
+    original, seen = engine._pre_step_function, []
+
+    def spying(*args):
+        function = original(*args)
+
+        def pre_step(mbs, t):
+            seen.append(exudyn.special.solver.throwErrorWithCtrlC)
+            return function(mbs, t)
+
+        pre_step.new_solve = function.new_solve
+        return pre_step
+
+    monkeypatch.setattr(engine, "_pre_step_function", spying)
+    before = exudyn.special.solver.throwErrorWithCtrlC
+    simulate(simplified_model(), 0.5)
+    assert seen and all(seen) and exudyn.special.solver.throwErrorWithCtrlC == before

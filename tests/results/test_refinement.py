@@ -7,6 +7,7 @@ import pytest
 
 from mbs_models import load_scene, model_ii, simulate
 from mbs_models.engine import simulation
+from mbs_models.results import refinement
 from mbs_models.results.refinement import Episodes, refine
 from mbs_models.results.samples import Interpolant
 from mbs_models.engine.mechanism import Mechanism
@@ -94,3 +95,55 @@ def test_an_impact_rises_by_the_threshold_above_the_force_at_rest_it_began_with(
     assert held.impact_mask(1000.0).tolist() == [True, True, False]
     # the force at rest at t = 0 concerns only the episode going on at the first sample
     assert _episodes([3, 50], [8500.0, 8500.0]).impact_mask(1000.0, 8500.0).tolist() == [True, True]
+
+
+@pytest.mark.parametrize("name", SEVERAL_CONTACTS)
+def test_batches_of_episodes_equal_one_batch(name, monkeypatch):
+    """Refined in batches of a few episodes (a long chattering run is), every contact gets what it gets in one
+    batch, and so does the support peak."""
+    mechanism, s = solved(load_scene(scene_path(name)), 3.0)
+    interp = Interpolant(s)
+    whole, support = refine(mechanism, s.time, s.forces, interp, mechanism.contacts, 1000.0, 10)
+    assert sum(len(e.first) for e in whole.values()) > 3  # several batches below
+    monkeypatch.setattr(refinement, "EPISODES_PER_BATCH", 2)
+    batched, batched_support = refine(mechanism, s.time, s.forces, interp, mechanism.contacts, 1000.0, 10)
+    assert batched_support == support
+    for contact in mechanism.contacts:
+        for field in Episodes.__dataclass_fields__:
+            assert np.array_equal(getattr(batched[contact.name], field), getattr(whole[contact.name], field)), \
+                (contact.name, field)
+
+
+def test_a_contact_s_refinement_interpolates_its_own_two_bodies_only(monkeypatch):
+    """The O(bodies x contacts) trap: with many absorbers, every round interpolated every body at every
+    contact's times.  Each contact's search asks for its own bodies (the barrel and its absorber), and the
+    support peak for the bodies on the ground's connectors."""
+    mechanism, s = solved(load_scene(scene_path("two_absorbers")), 3.0)
+    interp = Interpolant(s)
+    asked = []
+    original = Interpolant.state
+
+    def spy(self, t, bodies=None):
+        asked.append(bodies)
+        return original(self, t, bodies)
+
+    monkeypatch.setattr(Interpolant, "state", spy)
+    refine(mechanism, s.time, s.forces, interp, mechanism.contacts, 1000.0, 10)
+    assert asked and None not in asked
+    contact_bodies = {tuple(sorted({c.a, c.b} - {"ground"})) for c in mechanism.contacts}
+    ground_ends = {end for c in mechanism.connectors if c.support_sign for end in (c.a, c.b)} - {"ground"}
+    assert {tuple(sorted(b)) for b in asked} <= contact_bodies | {tuple(sorted(ground_ends))}
+    assert all(len(b) == 2 for b in asked if set(b) != ground_ends)
+
+
+def test_state_of_some_bodies_is_the_same_floats_as_of_all():
+    """Interpolant.state(t, bodies) gives each body's position and velocity bit for bit as state(t)."""
+    mechanism, s = solved(load_scene(scene_path("two_absorbers")), 3.0)
+    interp = Interpolant(s)
+    t = np.linspace(0.0, 3.0, 1001)
+    x, v = interp.state(t)
+    names = interp.names[::-1][:2]
+    some_x, some_v = interp.state(t, names)
+    assert list(some_x) == names
+    for name in names:
+        assert np.array_equal(some_x[name], x[name]) and np.array_equal(some_v[name], v[name])
