@@ -15,15 +15,26 @@ next one taken as one finishes, so that what a run holds does not depend on how 
   ``tcp://HOST:PORT`` or a ``dask.distributed.Client``.  The scheduler re-runs the tasks of a worker that
   dies.  Dask is imported only here, and only then (the ``cluster`` extra: ``pip install recoil-mbs[cluster]``).
 
+A worker process that dies (a crash in compiled code, the out-of-memory killer) reports nothing.  Given
+``lost`` (and ``split``), ``run`` does not end there: the tasks the death took (every task of a broken
+local pool) run again, cut into parts (``split(task)``: a sweep's batch point by point) handed out first;
+a part lost a second time runs alone (a pool of one process: a death is then that part's), and a part
+whose worker died alone too yields ``lost(part, reason)`` instead of its result -- so a point that kills
+its worker is a failed row and every other point runs.  On Dask the scheduler already re-runs a task
+whose worker died (``distributed.scheduler.allowed-failures`` times) before it reports ``KilledWorker``;
+the task is then split, and a part killed again is ``lost``.  Without ``lost`` a death ends the run.
+
 :func:`make_backend` picks one from ``workers``/``scheduler``; :data:`BACKENDS` maps names to classes.
 """
 
 from __future__ import annotations
 
+import collections
 import itertools
 import math
 import multiprocessing
 import os
+import signal
 import time
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
@@ -95,7 +106,11 @@ class SerialBackend:
     name = "serial"
     workers = 1
 
-    def run(self, function: Callable, tasks: Iterable, *, in_flight: int | None = None) -> Iterator[Any]:
+    def run(self, function: Callable, tasks: Iterable, *, in_flight: int | None = None,
+            split: Callable[[Any], list] | None = None, lost: Callable[[Any, str], Any] | None = None
+            ) -> Iterator[Any]:
+        """``function(task)`` of every task, in order (``split``/``lost``: for a worker's death, which cannot
+        happen here: a crash ends this process)."""
         for task in tasks:
             yield function(task)
 
@@ -118,38 +133,146 @@ class ProcessBackend(SerialBackend):
         self.workers = check_workers(workers)
         self._pool: ProcessPoolExecutor | None = None
 
-    def run(self, function: Callable, tasks: Iterable, *, in_flight: int | None = None) -> Iterator[Any]:
+    def run(self, function: Callable, tasks: Iterable, *, in_flight: int | None = None,
+            split: Callable[[Any], list] | None = None, lost: Callable[[Any, str], Any] | None = None
+            ) -> Iterator[Any]:
         limit = _check_in_flight(in_flight, self.workers)
         tasks = iter(tasks)
-        first = list(itertools.islice(tasks, limit))
-        if not first:
-            return
-        if self._pool is None:
-            self._pool = local_pool(self.workers)
-        pool, finished = self._pool, False
+        retry: collections.deque = collections.deque()   # (part, 1): parts of tasks a death took, first out
+
+        def take():
+            if retry:
+                return retry.popleft()
+            return next(((task, 0) for task in itertools.islice(tasks, 1)), None)
+
+        running: dict = {}   # future -> (task, deaths: how many pool deaths took it)
+        losses = _Losses(lost) if lost is not None else None
+        finished = False
         try:
-            running = {pool.submit(function, task) for task in first}
-            del first
-            while running:
-                done, running = wait(running, return_when=FIRST_COMPLETED)
-                for future in done:
-                    result = future.result()
-                    for task in itertools.islice(tasks, 1):
-                        running.add(pool.submit(function, task))
-                    yield result
+            while True:
+                broken = False
+                while len(running) < limit and (item := take()) is not None:
+                    if self._pool is None:
+                        self._pool = local_pool(self.workers)
+                    try:
+                        running[self._pool.submit(function, item[0])] = item
+                    except BrokenProcessPool:   # a worker died since the last look
+                        retry.appendleft(item)
+                        broken = True
+                        break
+                if not running and not broken:
+                    break
+                done = wait(running, return_when=FIRST_COMPLETED).done if running else set()
+                results, dead = _collect(done, running)
+                if dead or broken:   # the pool is broken: every task still running is lost with it
+                    if lost is None:
+                        raise BrokenProcessPool
+                    more_results, more_dead = _collect(wait(list(running)).done, running)
+                    results, dead = results + more_results, dead + more_dead
+                    self._drop_pool()
+                if results and losses is not None:
+                    yield from losses.release()
+                yield from results
+                for task, deaths in dead:
+                    if deaths == 0:
+                        retry.extend((part, 1) for part in (split(task) if split is not None else [task]))
+                    else:
+                        yield from self._alone(function, task, losses)
+            if losses is not None:
+                yield from losses.release()
             finished = True
-        except BrokenProcessPool:
+        except BrokenProcessPool:   # without ``lost``, a death ends the run
             raise SimulationError("a worker process died (killed, or out of memory); the points it had not "
                                   "finished are not in the table: run the same sweep again to resume") from None
         finally:
             if not finished:   # an error, an interrupt or a caller that stopped reading: no work left behind
-                self._pool = None
-                pool.shutdown(wait=True, cancel_futures=True)
+                self._drop_pool()
 
-    def close(self) -> None:
+    @staticmethod
+    def _alone(function: Callable, task: Any, losses: _Losses) -> Iterator[Any]:
+        """``function(task)`` in a pool of its own (one process): its result (after the held losses), or
+        nothing and the loss held if that process dies."""
+        pool = local_pool(1)
+        try:
+            try:
+                result = pool.submit(function, task).result()
+            except BrokenProcessPool:
+                losses.add(task, death_reason(pool))
+                return
+        finally:
+            pool.shutdown(wait=True, cancel_futures=True)
+        yield from losses.release()
+        yield result
+
+    def _drop_pool(self) -> None:
         if self._pool is not None:
             pool, self._pool = self._pool, None
             pool.shutdown(wait=True, cancel_futures=True)
+
+    def close(self) -> None:
+        self._drop_pool()
+
+
+#: Lost parts in a row (no task finishing in between) that end a run: something kills every worker.
+DEATHS_IN_A_ROW = 8
+
+
+class _Losses:
+    """The results ``lost(part, reason)`` of parts whose worker died even alone, held back until a task finishes
+    (workers can run: the deaths were the parts') or the run ends, and yielded then.  :data:`DEATHS_IN_A_ROW`
+    of them in a row end the run instead (SimulationError), none yielded: whatever kills every worker (too
+    little memory, a broken installation) is no point's fault, and they run again when the sweep resumes."""
+
+    def __init__(self, lost: Callable[[Any, str], Any]):
+        self.lost, self.held = lost, []
+
+    def add(self, task: Any, reason: str) -> None:
+        self.held.append(self.lost(task, reason))
+        if len(self.held) >= DEATHS_IN_A_ROW:
+            raise SimulationError(f"worker processes died on {len(self.held)} points in a row, each run alone "
+                                  f"(the last: {reason}): something kills every worker (too little memory?); "
+                                  "the rows written are kept: run the same sweep again to resume")
+
+    def release(self) -> list:
+        held, self.held = self.held, []
+        return held
+
+
+def _collect(done, running: dict) -> tuple[list, list]:
+    """The results of the finished futures ``done`` (removed from ``running``), and the ``(task, deaths)`` of
+    those a broken pool took; any other exception is raised."""
+    results, dead = [], []
+    for future in done:
+        task, deaths = running.pop(future)
+        if isinstance(future.exception(), BrokenProcessPool):
+            dead.append((task, deaths))
+        else:
+            results.append(future.result())
+    return results, dead
+
+
+def death_reason(pool: ProcessPoolExecutor) -> str:
+    """Why the worker of a one-process pool died, for the ``error`` of its point: the signal or exit code."""
+    codes = []
+    for process in list((getattr(pool, "_processes", None) or {}).values()):
+        try:
+            process.join(timeout=5.0)   # the pool reports its death before it has reaped the process
+        except (AssertionError, OSError, ValueError):
+            pass
+        if process.exitcode:
+            codes.append(process.exitcode)
+    text = "its worker process died"
+    if codes and codes[0] < 0:
+        try:
+            name = signal.Signals(-codes[0]).name
+        except ValueError:
+            name = f"signal {-codes[0]}"
+        cause = {"SIGKILL": ": killed, by the out-of-memory killer or a user?",
+                 "SIGSEGV": ": a crash in compiled code"}.get(name, "")
+        text = f"its worker process died of {name}{cause}"
+    elif codes:
+        text = f"its worker process exited with code {codes[0]}"
+    return f"{text} (each of the 3 times it ran: in its batch, again, then alone)"
 
 
 class DaskBackend(SerialBackend):
@@ -175,25 +298,47 @@ class DaskBackend(SerialBackend):
                                           f"got {scheduler!r}")
         self.workers = max(1, len(self.client.scheduler_info().get("workers", {})))
 
-    def run(self, function: Callable, tasks: Iterable, *, in_flight: int | None = None) -> Iterator[Any]:
+    def run(self, function: Callable, tasks: Iterable, *, in_flight: int | None = None,
+            split: Callable[[Any], list] | None = None, lost: Callable[[Any, str], Any] | None = None
+            ) -> Iterator[Any]:
         distributed = import_distributed()
         limit = _check_in_flight(in_flight, self.workers)
         tasks = iter(tasks)
         first = list(itertools.islice(tasks, limit))
         if not first:
             return
-        running = {self.client.submit(function, task, pure=False) for task in first}
+        running = {self.client.submit(function, task, pure=False): (task, 0) for task in first}   # -> (task, deaths)
         del first
         finished = distributed.as_completed(list(running), loop=self.client.loop)
+        losses = _Losses(lost) if lost is not None else None
+
+        def submit(task, deaths):
+            future = self.client.submit(function, task, pure=False)
+            running[future] = (task, deaths)
+            finished.add(future)
+
         try:
             for future in finished:
-                running.discard(future)
-                result = future.result()
-                for task in itertools.islice(tasks, 1):
-                    new = self.client.submit(function, task, pure=False)
-                    running.add(new)
-                    finished.add(new)
+                task, deaths = running.pop(future)
+                for more in itertools.islice(tasks, 1):
+                    submit(more, 0)
+                try:
+                    result = future.result()
+                except distributed.KilledWorker as exc:   # the scheduler ran it on allowed-failures workers
+                    if losses is None:
+                        raise
+                    if deaths == 0 and split is not None and len(parts := split(task)) > 1:
+                        for part in parts:
+                            submit(part, 1)
+                    else:
+                        losses.add(task, f"the Dask workers running it died ({type(exc).__name__}: "
+                                         f"{str(exc).splitlines()[0] if str(exc) else 'no message'})")
+                    continue
+                if losses is not None:
+                    yield from losses.release()
                 yield result
+            if losses is not None:
+                yield from losses.release()
         finally:
             self.client.cancel([f for f in running if not f.done()])
 
@@ -230,4 +375,5 @@ def make_backend(workers: int | None = None, scheduler: Any = None):
 
 
 __all__ = ["BACKENDS", "SerialBackend", "ProcessBackend", "DaskBackend", "make_backend", "batch_size", "in_flight",
-           "default_workers", "check_workers", "import_distributed", "exit_with_parent", "local_pool"]
+           "default_workers", "check_workers", "import_distributed", "exit_with_parent", "local_pool", "death_reason",
+           "DEATHS_IN_A_ROW"]
