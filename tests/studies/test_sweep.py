@@ -492,9 +492,9 @@ def test_table_false_returns_the_summary_and_lists_the_first_failures(tmp_path, 
 def test_a_file_in_any_order_is_resumed_and_ends_in_grid_order(tmp_path, suffix):
     """A file whose rows are in finish order (shuffled here), with points missing, resumes and ends in grid order;
     the kept rows are those of the file (their wall times)."""
-    full = run_sweep(model_i(), FIG_GRID, end_time=0.5, workers=1, progress=False)
-    kept = full.drop(index=[1, 4]).sample(frac=1.0, random_state=3)
     path = tmp_path / f"s{suffix}"
+    full = run_sweep(model_i(), FIG_GRID, end_time=0.5, workers=1, progress=False, out=path)  # and its settings
+    kept = full.drop(index=[1, 4]).sample(frac=1.0, random_state=3)
     if suffix == ".csv":
         kept.to_csv(path, index=False)
     else:
