@@ -23,6 +23,9 @@ whose worker died alone too yields ``lost(part, reason)`` instead of its result 
 its worker is a failed row and every other point runs.  On Dask the scheduler already re-runs a task
 whose worker died (``distributed.scheduler.allowed-failures`` times) before it reports ``KilledWorker``;
 the task is then split, and a part killed again is ``lost``.  Without ``lost`` a death ends the run.
+Whatever kills *every* worker (too little memory for any process) is no point's fault: after
+:data:`DEATHS_IN_A_ROW` lost parts in a row, the last task that finished runs again, alone, and if it
+dies too (or none has finished) the run ends with a SimulationError, those parts not yielded (``_Losses``).
 
 :func:`make_backend` picks one from ``workers``/``scheduler``; :data:`BACKENDS` maps names to classes.
 """
@@ -132,6 +135,7 @@ class ProcessBackend(SerialBackend):
     def __init__(self, workers: int | None = None):
         self.workers = check_workers(workers)
         self._pool: ProcessPoolExecutor | None = None
+        self._losses = _Losses()
 
     def run(self, function: Callable, tasks: Iterable, *, in_flight: int | None = None,
             split: Callable[[Any], list] | None = None, lost: Callable[[Any, str], Any] | None = None
@@ -146,7 +150,7 @@ class ProcessBackend(SerialBackend):
             return next(((task, 0) for task in itertools.islice(tasks, 1)), None)
 
         running: dict = {}   # future -> (task, deaths: how many pool deaths took it)
-        losses = _Losses(lost) if lost is not None else None
+        self._losses.start(lost, lambda task: self._alone(function, task)[0])
         finished = False
         try:
             while True:
@@ -170,16 +174,20 @@ class ProcessBackend(SerialBackend):
                     more_results, more_dead = _collect(wait(list(running)).done, running)
                     results, dead = results + more_results, dead + more_dead
                     self._drop_pool()
-                if results and losses is not None:
-                    yield from losses.release()
-                yield from results
+                for task, result in results:
+                    yield from self._losses.finished(task)
+                    yield result
                 for task, deaths in dead:
                     if deaths == 0:
                         retry.extend((part, 1) for part in (split(task) if split is not None else [task]))
+                        continue
+                    ran, result = self._alone(function, task)
+                    if ran:
+                        yield from self._losses.finished(task)
+                        yield result
                     else:
-                        yield from self._alone(function, task, losses)
-            if losses is not None:
-                yield from losses.release()
+                        yield from self._losses.add(task, result)
+            yield from self._losses.release()
             finished = True
         except BrokenProcessPool:   # without ``lost``, a death ends the run
             raise SimulationError("a worker process died (killed, or out of memory); the points it had not "
@@ -189,20 +197,17 @@ class ProcessBackend(SerialBackend):
                 self._drop_pool()
 
     @staticmethod
-    def _alone(function: Callable, task: Any, losses: _Losses) -> Iterator[Any]:
-        """``function(task)`` in a pool of its own (one process): its result (after the held losses), or
-        nothing and the loss held if that process dies."""
+    def _alone(function: Callable, task: Any) -> tuple[bool, Any]:
+        """``function(task)`` in a pool of its own (one process): ``(True, result)``, or ``(False, why it
+        died)`` if that process dies."""
         pool = local_pool(1)
         try:
             try:
-                result = pool.submit(function, task).result()
+                return True, pool.submit(function, task).result()
             except BrokenProcessPool:
-                losses.add(task, death_reason(pool))
-                return
+                return False, death_reason(pool)
         finally:
             pool.shutdown(wait=True, cancel_futures=True)
-        yield from losses.release()
-        yield result
 
     def _drop_pool(self) -> None:
         if self._pool is not None:
@@ -213,25 +218,45 @@ class ProcessBackend(SerialBackend):
         self._drop_pool()
 
 
-#: Lost parts in a row (no task finishing in between) that end a run: something kills every worker.
+#: Parts in a row whose worker died even alone, before the backend checks that its workers can run at all.
 DEATHS_IN_A_ROW = 8
 
 
 class _Losses:
-    """The results ``lost(part, reason)`` of parts whose worker died even alone, held back until a task finishes
-    (workers can run: the deaths were the parts') or the run ends, and yielded then.  :data:`DEATHS_IN_A_ROW`
-    of them in a row end the run instead (SimulationError), none yielded: whatever kills every worker (too
-    little memory, a broken installation) is no point's fault, and they run again when the sweep resumes."""
+    """The results ``lost(part, reason)`` of parts whose worker died even alone (:meth:`add`), held back while
+    it is not known whether the parts killed their workers or something kills every worker (too little
+    memory for any process, a broken installation: no point's fault).  They are yielded once a task
+    finishes (:meth:`finished`) or the run ends; :data:`DEATHS_IN_A_ROW` of them in a row make the backend
+    ``rerun`` (alone) the last task that finished: if it finishes again the parts were at fault and their
+    results are yielded, else -- or with no task finished yet -- the run ends (SimulationError), none of
+    them yielded: they run again when the sweep resumes."""
 
-    def __init__(self, lost: Callable[[Any, str], Any]):
-        self.lost, self.held = lost, []
+    def __init__(self):
+        self.lost = self.rerun = None
+        self.held: list = []
+        self.canary: Any = None   # the last task that finished: it can run
 
-    def add(self, task: Any, reason: str) -> None:
+    def start(self, lost: Callable[[Any, str], Any] | None, rerun: Callable[[Any], bool]) -> None:
+        """A run starts (nothing held from a run that ended early)."""
+        self.lost, self.rerun, self.held = lost, rerun, []
+
+    def finished(self, task: Any) -> list:
+        """A task finished: workers can run; the held results, to yield before its own."""
+        self.canary = task
+        return self.release()
+
+    def add(self, task: Any, reason: str) -> list:
+        """A part's worker died even alone: the results to yield now (none while held)."""
         self.held.append(self.lost(task, reason))
-        if len(self.held) >= DEATHS_IN_A_ROW:
-            raise SimulationError(f"worker processes died on {len(self.held)} points in a row, each run alone "
-                                  f"(the last: {reason}): something kills every worker (too little memory?); "
-                                  "the rows written are kept: run the same sweep again to resume")
+        if len(self.held) < DEATHS_IN_A_ROW:
+            return []
+        if self.canary is not None and self.rerun(self.canary):
+            return self.release()
+        count, self.held = len(self.held), []
+        test = "a point that ran before died too" if self.canary is not None else "no point has run yet"
+        raise SimulationError(f"worker processes died on {count} points in a row, each run alone (the last: "
+                              f"{reason}), and {test}: something kills every worker (too little memory?); the "
+                              "rows written are kept: run the same sweep again to resume")
 
     def release(self) -> list:
         held, self.held = self.held, []
@@ -239,15 +264,15 @@ class _Losses:
 
 
 def _collect(done, running: dict) -> tuple[list, list]:
-    """The results of the finished futures ``done`` (removed from ``running``), and the ``(task, deaths)`` of
-    those a broken pool took; any other exception is raised."""
+    """``(task, result)`` of the finished futures ``done`` (removed from ``running``), and the ``(task,
+    deaths)`` of those a broken pool took; any other exception is raised."""
     results, dead = [], []
     for future in done:
         task, deaths = running.pop(future)
         if isinstance(future.exception(), BrokenProcessPool):
             dead.append((task, deaths))
         else:
-            results.append(future.result())
+            results.append((task, future.result()))
     return results, dead
 
 
@@ -261,18 +286,18 @@ def death_reason(pool: ProcessPoolExecutor) -> str:
             pass
         if process.exitcode:
             codes.append(process.exitcode)
-    text = "its worker process died"
+    how = ""
     if codes and codes[0] < 0:
         try:
             name = signal.Signals(-codes[0]).name
         except ValueError:
             name = f"signal {-codes[0]}"
-        cause = {"SIGKILL": ": killed, by the out-of-memory killer or a user?",
-                 "SIGSEGV": ": a crash in compiled code"}.get(name, "")
-        text = f"its worker process died of {name}{cause}"
+        cause = {"SIGKILL": " (the out-of-memory killer? a user?)", "SIGSEGV": " (a crash in compiled code)",
+                 "SIGBUS": " (a crash in compiled code)", "SIGABRT": " (an abort in compiled code)"}.get(name, "")
+        how = f" of {name}{cause}"
     elif codes:
-        text = f"its worker process exited with code {codes[0]}"
-    return f"{text} (each of the 3 times it ran: in its batch, again, then alone)"
+        how = f" (exit code {codes[0]})"
+    return f"its worker process died{how} each of the 3 times it ran it (in its batch, again, then alone)"
 
 
 class DaskBackend(SerialBackend):
@@ -297,6 +322,7 @@ class DaskBackend(SerialBackend):
             raise SceneError("scheduler", f"must be an address tcp://HOST:PORT or a dask.distributed.Client, "
                                           f"got {scheduler!r}")
         self.workers = max(1, len(self.client.scheduler_info().get("workers", {})))
+        self._losses = _Losses()
 
     def run(self, function: Callable, tasks: Iterable, *, in_flight: int | None = None,
             split: Callable[[Any], list] | None = None, lost: Callable[[Any, str], Any] | None = None
@@ -310,12 +336,20 @@ class DaskBackend(SerialBackend):
         running = {self.client.submit(function, task, pure=False): (task, 0) for task in first}   # -> (task, deaths)
         del first
         finished = distributed.as_completed(list(running), loop=self.client.loop)
-        losses = _Losses(lost) if lost is not None else None
 
         def submit(task, deaths):
             future = self.client.submit(function, task, pure=False)
             running[future] = (task, deaths)
             finished.add(future)
+
+        def rerun(task) -> bool:
+            try:
+                self.client.submit(function, task, pure=False).result()
+                return True
+            except distributed.KilledWorker:
+                return False
+
+        self._losses.start(lost, rerun)
 
         try:
             for future in finished:
@@ -325,20 +359,18 @@ class DaskBackend(SerialBackend):
                 try:
                     result = future.result()
                 except distributed.KilledWorker as exc:   # the scheduler ran it on allowed-failures workers
-                    if losses is None:
+                    if lost is None:
                         raise
                     if deaths == 0 and split is not None and len(parts := split(task)) > 1:
                         for part in parts:
                             submit(part, 1)
                     else:
-                        losses.add(task, f"the Dask workers running it died ({type(exc).__name__}: "
-                                         f"{str(exc).splitlines()[0] if str(exc) else 'no message'})")
+                        yield from self._losses.add(task, f"the Dask workers running it died ({type(exc).__name__}"
+                                                          f": {str(exc).splitlines()[0] if str(exc) else 'no message'})")
                     continue
-                if losses is not None:
-                    yield from losses.release()
+                yield from self._losses.finished(task)
                 yield result
-            if losses is not None:
-                yield from losses.release()
+            yield from self._losses.release()
         finally:
             self.client.cancel([f for f in running if not f.done()])
 
