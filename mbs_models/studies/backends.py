@@ -21,8 +21,10 @@ local pool) run again, cut into parts (``split(task)``: a sweep's batch point by
 a part lost a second time runs alone (a pool of one process: a death is then that part's), and a part
 whose worker died alone too yields ``lost(part, reason)`` instead of its result -- so a point that kills
 its worker is a failed row and every other point runs.  On Dask the scheduler already re-runs a task
-whose worker died (``distributed.scheduler.allowed-failures`` times) before it reports ``KilledWorker``;
-the task is then split, and a part killed again is ``lost``.  Without ``lost`` a death ends the run.
+whose worker died (``distributed.scheduler.allowed-failures`` times) before it reports ``KilledWorker``
+-- for every task its worker held, not only the one that killed it; the task is then split, its parts
+submitted again, a part killed again submitted once more and waited for (the others go on), and ``lost``
+if that one is killed too.  Without ``lost`` a death ends the run.
 Whatever kills *every* worker (too little memory for any process) is no point's fault: after
 :data:`DEATHS_IN_A_ROW` lost parts in a row, the last task that finished runs again, alone, and if it
 dies too (or none has finished) the run ends with a SimulationError, those parts not yielded (``_Losses``).
@@ -342,14 +344,7 @@ class DaskBackend(SerialBackend):
             running[future] = (task, deaths)
             finished.add(future)
 
-        def rerun(task) -> bool:
-            try:
-                self.client.submit(function, task, pure=False).result()
-                return True
-            except distributed.KilledWorker:
-                return False
-
-        self._losses.start(lost, rerun)
+        self._losses.start(lost, lambda task: self._alone(function, task)[0])
 
         try:
             for future in finished:
@@ -358,21 +353,31 @@ class DaskBackend(SerialBackend):
                     submit(more, 0)
                 try:
                     result = future.result()
-                except distributed.KilledWorker as exc:   # the scheduler ran it on allowed-failures workers
+                except distributed.KilledWorker:   # it ran on allowed-failures + 1 workers, all died
                     if lost is None:
                         raise
-                    if deaths == 0 and split is not None and len(parts := split(task)) > 1:
-                        for part in parts:
+                    if deaths == 0:
+                        for part in (split(task) if split is not None else [task]):
                             submit(part, 1)
-                    else:
-                        yield from self._losses.add(task, f"the Dask workers running it died ({type(exc).__name__}"
-                                                          f": {str(exc).splitlines()[0] if str(exc) else 'no message'})")
-                    continue
+                        continue
+                    ran, result = self._alone(function, task)   # the others in flight go on meanwhile
+                    if not ran:
+                        yield from self._losses.add(task, result)
+                        continue
                 yield from self._losses.finished(task)
                 yield result
             yield from self._losses.release()
         finally:
             self.client.cancel([f for f in running if not f.done()])
+
+    def _alone(self, function: Callable, task: Any) -> tuple[bool, Any]:
+        """``function(task)`` submitted again and waited for: ``(True, result)``, or ``(False, why)`` if the
+        scheduler reports its workers killed again."""
+        distributed = import_distributed()
+        try:
+            return True, self.client.submit(function, task, pure=False).result()
+        except distributed.KilledWorker as exc:
+            return False, f"the Dask workers running it died each time the scheduler tried it ({type(exc).__name__})"
 
     def close(self) -> None:
         if self._own:
