@@ -117,6 +117,7 @@ def run_sweep(scene: Scene, params, *, end_time: float = 10.0, accuracy: str | S
     say = _announcer(announce, progress)
     with contextlib.ExitStack() as held:
         if out is not None:
+            _check_cells(grid)
             file = SweepFile(out, params_columns, metrics, kinds=kinds)
             held.enter_context(SweepLock(file.path))   # one sweep per file: another one is refused here
             file.clean_temporaries()                    # what a killed run's rewrite left
@@ -168,6 +169,14 @@ def run_points(backend, tasks):
     from .point import evaluate_batch, lost_batch, split_batch
 
     return backend.run(evaluate_batch, tasks, split=split_batch, lost=lost_batch)
+
+
+def _check_cells(grid) -> None:
+    """SceneError if a parameter's table cell holds a line break (a file's rows are read back line by line)."""
+    for key, cells in zip(grid.keys, grid.cells):
+        for cell in cells:
+            if isinstance(cell, str) and ("\n" in cell or "\r" in cell):
+                raise SceneError(key, f"{cell!r} holds a line break, which a cell of the table's file cannot hold")
 
 
 def _note(say, text: str) -> None:

@@ -7,7 +7,8 @@ process that holds it (the lock file holds ``process PID on HOST since TIME``). 
 lock when its process ends, however it ends (a SIGKILL, the out-of-memory killer): a stale lock file never
 blocks a later run, which simply takes it.  (A POSIX lock is the process's own -- a forked worker does
 not hold it -- and works on NFS v4; it does not exclude the process itself, so the lock files this process
-holds are also kept in :data:`_HELD`.)  The holder removes the file when it is done; a taker that finds
+holds are also kept in :data:`_HELD`; and closing any descriptor of the file drops the process's lock, so
+its holder reads it only through its own.)  The holder removes the file when it is done; a taker that finds
 the file it locked replaced or removed meanwhile tries again.  On a file system without locks (``ENOLCK``)
 the sweep runs unlocked, with a warning.
 """
@@ -83,7 +84,10 @@ class SweepLock:
     def holder(self) -> str:
         """Who holds the lock, as its file says (``process PID on HOST since TIME``), or ``another process``."""
         try:
-            text = self.path.read_text(encoding="utf-8", errors="replace").strip()
+            if self._fd is not None:   # ours: read through our descriptor (closing another one would drop the lock)
+                text = os.pread(self._fd, 4096, 0).decode("utf-8", "replace").strip()
+            else:
+                text = self.path.read_text(encoding="utf-8", errors="replace").strip()
         except OSError:
             text = ""
         return text.splitlines()[0] if text else "another process"

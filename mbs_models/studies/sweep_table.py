@@ -294,8 +294,8 @@ class SweepFile:
                 continue
             unreadable = Unreadable(path, "line" if fmt == "csv" else "row")
             try:
-                pieces = self._csv_pieces(path, unreadable) if fmt == "csv" else self._parquet_pieces(path)
-                for raw, numbers, quoted in pieces:
+                pieces = self._csv_pieces(path) if fmt == "csv" else self._parquet_pieces(path)
+                for raw, numbers, quoted, dropped in pieces:
                     kinds = self.kinds or {param: _inferred_kind(raw[param]) for param in self.params}
                     clean, broken, foreign = check_rows(raw, self.params, self.metrics, kinds, quoted)
                     if foreign is not None:
@@ -303,8 +303,8 @@ class SweepFile:
                         raise SceneError("out", f"{path} holds another sweep's rows ({unreadable.unit} "
                                                 f"{numbers[position]}: {why}): choose another file, or delete it "
                                                 "to start again")
+                    unreadable.add(np.sort(np.concatenate([dropped, numbers[broken]])))
                     if broken.any():
-                        unreadable.add(numbers[broken])
                         clean = clean[~broken]
                     if len(clean):
                         yield typed(clean, self.params, self.metrics, kinds)
@@ -328,7 +328,7 @@ class SweepFile:
             raise SceneError("out", f"{path} holds another sweep's table (its columns differ from this sweep's): "
                                     "choose another file, or delete it to start again")
 
-    def _csv_pieces(self, path: Path, unreadable: Unreadable) -> Iterator[tuple[pd.DataFrame, np.ndarray, np.ndarray]]:
+    def _csv_pieces(self, path: Path) -> Iterator[tuple[pd.DataFrame, np.ndarray, np.ndarray, np.ndarray]]:
         drop_cut_line(path)
         if path.stat().st_size == 0:
             return
@@ -336,9 +336,9 @@ class SweepFile:
         with open(path, "rb") as handle:
             header = read_header(handle, self.columns)
             self._check_columns(header or [], path)
-            yield from csv_chunks(handle, self.columns, text, self.chunk_rows, unreadable)
+            yield from csv_chunks(handle, self.columns, text, self.chunk_rows)
 
-    def _parquet_pieces(self, path: Path) -> Iterator[tuple[pd.DataFrame, np.ndarray, None]]:
+    def _parquet_pieces(self, path: Path) -> Iterator[tuple[pd.DataFrame, np.ndarray, None, np.ndarray]]:
         import pyarrow.parquet as pq
 
         source = pq.ParquetFile(path)
@@ -346,7 +346,7 @@ class SweepFile:
         first = 1
         for batch in source.iter_batches(batch_size=self.chunk_rows):
             raw = batch.to_pandas()
-            yield raw, np.arange(first, first + len(raw), dtype=np.int64), None
+            yield raw, np.arange(first, first + len(raw), dtype=np.int64), None, np.zeros(0, dtype=np.int64)
             first += len(raw)
 
     # ------------------------------------------------------------------ writing

@@ -83,12 +83,14 @@ class Unreadable:
 # ================================================================================================ writing
 def csv_text(table: pd.DataFrame, header: bool) -> str:
     """``table`` as CSV text (pandas' ``to_csv``: the shortest exact floats, empty for a missing value), the
-    ``error`` cell always quoted (module docstring); with the header line if ``header``."""
+    ``error`` cell always quoted (module docstring); with the header line if ``header``.  ValueError if a cell
+    holds a line break (rows are read back line by line: :func:`~mbs_models.studies.point.error_text` makes
+    messages one line, and a sweep refuses parameter values with one)."""
     error = table["error"]
     body = table.drop(columns="error").to_csv(index=False, header=header, lineterminator="\n")
     lines = body.split("\n")[:-1]
-    if len(lines) != len(table) + header:   # a cell with a line break (a text parameter): everything quoted
-        return table.to_csv(index=False, header=header, lineterminator="\n", quoting=csv.QUOTE_NONNUMERIC)
+    if len(lines) != len(table) + header or any(isinstance(e, str) and ("\n" in e or "\r" in e) for e in error):
+        raise ValueError("a cell of a sweep's table holds a line break: its rows are read line by line")
     cells = (["error"] if header else []) + [
         "" if value is None or value != value else '"' + str(value).replace('"', '""') + '"'
         for value in error.to_numpy(dtype=object)]
@@ -125,12 +127,12 @@ def _one_row(line: bytes, cells: int) -> bool:
         return False
 
 
-def csv_chunks(handle, columns: Sequence[str], text_columns: Sequence[str], chunk_rows: int,
-               unreadable: Unreadable, first_line: int = 2) -> Iterator[tuple[pd.DataFrame, np.ndarray, np.ndarray]]:
-    """``(raw, line_numbers, quoted_end)`` for each ``chunk_rows`` lines of ``handle`` (binary, after the
-    header): the rows parsed (texts as ``object``, the rest as pandas infers), each one's line number, and
-    whether its line ends with a quote.  Lines that cannot be one row go to ``unreadable``; blank lines are
-    no rows."""
+def csv_chunks(handle, columns: Sequence[str], text_columns: Sequence[str], chunk_rows: int, first_line: int = 2
+               ) -> Iterator[tuple[pd.DataFrame, np.ndarray, np.ndarray, np.ndarray]]:
+    """``(raw, line_numbers, quoted_end, dropped)`` for each ``chunk_rows`` lines of ``handle`` (binary, after
+    the header): the rows parsed (texts as ``object``, the rest as pandas infers), each one's line number,
+    whether its line ends with a quote, and the numbers of the lines that cannot be one row (dropped).  Blank
+    lines are no rows."""
     number = first_line
     text = {column: object for column in text_columns}
     while True:
@@ -149,14 +151,12 @@ def csv_chunks(handle, columns: Sequence[str], text_columns: Sequence[str], chun
                 else:
                     dropped.append(number)
             number += 1
-        unreadable.add(np.array(dropped, dtype=np.int64))
-        if kept:
-            raw = _parse(kept, columns, text)
-            if raw is None or len(raw) != len(kept):   # pandas saw the lines otherwise: one at a time
-                raw, keep = _parse_each(kept, columns, text)
-                unreadable.add(np.array(numbers, dtype=np.int64)[~keep])
-                numbers, quoted = list(np.array(numbers)[keep]), list(np.array(quoted)[keep])
-            yield raw, np.array(numbers, dtype=np.int64), np.array(quoted, dtype=bool)
+        raw = _parse(kept, columns, text) if kept else _parse_each([], columns, text)[0]
+        if raw is None or len(raw) != len(kept):   # pandas saw the lines otherwise: one at a time
+            raw, keep = _parse_each(kept, columns, text)
+            dropped += [n for n, k in zip(numbers, keep) if not k]
+            numbers, quoted = [n for n, k in zip(numbers, keep) if k], [q for q, k in zip(quoted, keep) if k]
+        yield raw, np.array(numbers, dtype=np.int64), np.array(quoted, dtype=bool), np.array(dropped, dtype=np.int64)
 
 
 def _parse(lines: list[bytes], columns: Sequence[str], text: Mapping[str, type]) -> pd.DataFrame | None:
