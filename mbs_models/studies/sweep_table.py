@@ -301,8 +301,8 @@ class SweepFile:
                     if foreign is not None:
                         position, why = foreign
                         raise SceneError("out", f"{path} holds another sweep's rows ({unreadable.unit} "
-                                                f"{numbers[position]}: {why}): choose another file, or delete it "
-                                                "to start again")
+                                                f"{numbers[position]}: {why}): choose another file, remove those "
+                                                "rows, or delete it to start again")
                     unreadable.add(np.sort(np.concatenate([dropped, numbers[broken]])))
                     if broken.any():
                         clean = clean[~broken]
