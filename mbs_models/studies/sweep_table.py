@@ -2,7 +2,7 @@
 
 One row per point: the parameters (one column per dotted key), the metrics
 (:func:`~mbs_models.studies.point.metric_columns`), ``wall_time``, ``status``, ``error``.  Types are
-fixed by the column (:func:`frame` for rows, :func:`typed` for a table read back): parameters as
+fixed by the column (:func:`frame` for rows, :func:`~.table_rows.check_rows` for a table read back): parameters as
 :func:`~mbs_models.studies.grid.column_values` gives them (``kinds``: float, bool or text), metrics
 ``float64``, counts nullable ``Int64``, text ``object`` (None where empty), so that a table read back from
 its file equals the one built in memory.
@@ -126,42 +126,6 @@ def _missing(value: Any) -> bool:
     return isinstance(value, float) and value != value
 
 
-def _text(column: pd.Series) -> pd.Series:
-    """A column as ``object`` text: ``str`` values, None where empty."""
-    values = column.to_numpy(dtype=object, na_value=None)
-    return pd.Series([None if _missing(v) else str(v) for v in values], dtype=object, index=column.index)
-
-
-def typed(raw: pd.DataFrame, params: Sequence[str], metrics: Sequence[str],
-          kinds: Mapping[str, str] | None = None) -> pd.DataFrame:
-    """A table read back (from CSV or Parquet) with the types :func:`frame` gives its rows, column by column
-    (vectorised: ``typed(read) == frame(rows)``); ValueError if a column cannot have its type (the file holds
-    another sweep)."""
-    columns = [*params, *metrics, *STATUS_COLUMNS]
-    data = {}
-    for column in columns:
-        values = raw[column].reset_index(drop=True)
-        if column in params:
-            kind = kinds[column] if kinds else _inferred_kind(values)
-            if kind == "float":
-                if not (pd.api.types.is_numeric_dtype(values) and not pd.api.types.is_bool_dtype(values)):
-                    raise ValueError(f"column {column!r} does not hold numbers")
-                data[column] = values.to_numpy(dtype="float64", na_value=np.nan)
-            elif kind == "bool":
-                if not pd.api.types.is_bool_dtype(values):
-                    raise ValueError(f"column {column!r} does not hold true/false")
-                data[column] = values.to_numpy(dtype=bool)
-            else:
-                data[column] = _text(values)
-        elif is_text(column):
-            data[column] = _text(values)
-        elif is_count(column):
-            data[column] = pd.array(values.to_numpy(dtype="float64", na_value=np.nan), dtype="Int64")
-        else:
-            data[column] = values.to_numpy(dtype="float64", na_value=np.nan)
-    return pd.DataFrame(data, columns=columns)
-
-
 def _inferred_kind(values: pd.Series) -> str:
     """A parameter column's kind as :func:`frame` would infer it from the rows."""
     if len(values) and pd.api.types.is_bool_dtype(values):
@@ -283,7 +247,7 @@ class SweepFile:
     def chunks(self) -> Iterator[pd.DataFrame]:
         """The rows a previous run left (the table, then a Parquet table's journal), checked
         (:func:`~mbs_models.studies.table_rows.check_rows`: the unreadable ones dropped and counted in
-        :attr:`unreadable`) and typed (:func:`typed`), ``chunk_rows`` at a time; SceneError if the file holds
+        :attr:`unreadable`) and typed as :func:`frame` types rows, ``chunk_rows`` at a time; SceneError if the file holds
         another table (other columns, or parameters of other kinds) or cannot be read."""
         sources = [(self.path, self.format)]
         if self.journal_path is not None:
@@ -304,10 +268,8 @@ class SweepFile:
                                                 f"{numbers[position]}: {why}): choose another file, remove those "
                                                 "rows, or delete it to start again")
                     unreadable.add(np.sort(np.concatenate([dropped, numbers[broken]])))
-                    if broken.any():
-                        clean = clean[~broken]
                     if len(clean):
-                        yield typed(clean, self.params, self.metrics, kinds)
+                        yield clean
             except (OSError, ValueError, KeyError) as exc:
                 if isinstance(exc, SceneError):
                     raise
@@ -507,5 +469,5 @@ def drop_cut_line(path: Path, block: int = 1 << 16) -> None:
         handle.truncate(0)
 
 
-__all__ = ["SweepFile", "SweepWriteError", "writing", "frame", "typed", "param_kinds", "check_out", "FORMATS",
+__all__ = ["SweepFile", "SweepWriteError", "writing", "frame", "param_kinds", "check_out", "FORMATS",
            "CHUNK_ROWS", "parquet_schema", "drop_cut_line"]

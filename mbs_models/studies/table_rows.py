@@ -26,6 +26,7 @@ from __future__ import annotations
 import csv
 import io
 import itertools
+import re
 from pathlib import Path
 from typing import Iterator, Mapping, Sequence
 
@@ -127,41 +128,67 @@ def _one_row(line: bytes, cells: int) -> bool:
         return False
 
 
+def line_checks(data: bytes, lengths: np.ndarray, cells: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """For each line of ``data`` (lines of ``lengths`` bytes, each ending in a newline): whether it can be one
+    row of ``cells`` cells (the number of commas outside quotes; quotes paired, no NUL byte, UTF-8), whether it
+    is empty (no row at all), whether it ends with a quote.  Vectorised over the bytes; only a line holding a
+    quote, a NUL or a byte beyond ASCII is looked at alone (:func:`_one_row`)."""
+    ends = np.cumsum(lengths) - 1                   # the index of each line's newline
+    starts = ends - lengths + 1
+    array = np.frombuffer(data, dtype=np.uint8)
+    before = np.maximum(ends - 1, 0)
+    crlf = (lengths >= 2) & (array[before] == 13)
+    empty = (lengths == 1) | ((lengths == 2) & crlf)
+    last = np.maximum(np.where(crlf, ends - 2, ends - 1), 0)
+    quoted_end = (lengths >= 2 + crlf) & (array[last] == 34)
+    commas = np.flatnonzero(array == 44)            # (8 bytes a comma: reduceat would cast every byte to int64)
+    fits = np.searchsorted(commas, ends) - np.searchsorted(commas, starts) + 1 == cells
+    del commas
+    special = [np.flatnonzero(array == byte) for byte, found in ((34, b'"' in data), (0, b"\0" in data)) if found]
+    if not data.isascii():
+        special.append(np.flatnonzero(array >= 128))
+    if special:
+        for i in np.unique(np.searchsorted(ends, np.concatenate(special))):
+            fits[i] = _one_row(data[starts[i]:ends[i] + 1], cells)
+    return fits & ~empty, empty, quoted_end
+
+
 def csv_chunks(handle, columns: Sequence[str], text_columns: Sequence[str], chunk_rows: int, first_line: int = 2
                ) -> Iterator[tuple[pd.DataFrame, np.ndarray, np.ndarray, np.ndarray]]:
     """``(raw, line_numbers, quoted_end, dropped)`` for each ``chunk_rows`` lines of ``handle`` (binary, after
     the header): the rows parsed (texts as ``object``, the rest as pandas infers), each one's line number,
-    whether its line ends with a quote, and the numbers of the lines that cannot be one row (dropped).  Blank
-    lines are no rows."""
+    whether its line ends with a quote, and the numbers of the lines that cannot be one row (dropped:
+    :func:`line_checks`).  Empty lines are no rows."""
     number = first_line
     text = {column: object for column in text_columns}
     while True:
         lines = list(itertools.islice(handle, chunk_rows))
         if not lines:
             return
-        kept, numbers, quoted, dropped = [], [], [], []
-        for line in lines:
-            if line.strip():
-                if not line.endswith(b"\n"):
-                    line += b"\n"
-                if _one_row(line, len(columns)):
-                    kept.append(line)
-                    numbers.append(number)
-                    quoted.append(line.rstrip(b"\r\n").endswith(b'"'))
-                else:
-                    dropped.append(number)
-            number += 1
-        raw = _parse(kept, columns, text) if kept else _parse_each([], columns, text)[0]
-        if raw is None or len(raw) != len(kept):   # pandas saw the lines otherwise: one at a time
-            raw, keep = _parse_each(kept, columns, text)
-            dropped += [n for n, k in zip(numbers, keep) if not k]
-            numbers, quoted = [n for n, k in zip(numbers, keep) if k], [q for q, k in zip(quoted, keep) if k]
-        yield raw, np.array(numbers, dtype=np.int64), np.array(quoted, dtype=bool), np.array(dropped, dtype=np.int64)
+        if not lines[-1].endswith(b"\n"):
+            lines[-1] += b"\n"
+        lengths = np.fromiter(map(len, lines), dtype=np.int64, count=len(lines))
+        data = b"".join(lines)
+        del lines                                   # the chunk is held once: its bytes
+        fits, empty, quoted = line_checks(data, lengths, len(columns))
+        numbers = np.arange(number, number + len(lengths), dtype=np.int64)
+        number += len(lengths)
+        dropped = numbers[~fits & ~empty]
+        if not fits.all():
+            ends = np.cumsum(lengths)
+            data = b"".join(data[end - length:end] for end, length in zip(ends[fits], lengths[fits]))
+        numbers, quoted = numbers[fits], quoted[fits]
+        raw = _parse(data, columns, text) if len(numbers) else None
+        if raw is None or len(raw) != len(numbers):   # pandas saw the lines otherwise: one at a time
+            raw, keep = _parse_each(data.splitlines(keepends=True), columns, text)
+            dropped = np.sort(np.concatenate([dropped, numbers[~keep]]))
+            numbers, quoted = numbers[keep], quoted[keep]
+        yield raw, numbers, quoted, dropped
 
 
-def _parse(lines: list[bytes], columns: Sequence[str], text: Mapping[str, type]) -> pd.DataFrame | None:
+def _parse(data: bytes, columns: Sequence[str], text: Mapping[str, type]) -> pd.DataFrame | None:
     try:
-        return pd.read_csv(io.BytesIO(b"".join(lines)), names=list(columns), header=None, index_col=False,
+        return pd.read_csv(io.BytesIO(data), names=list(columns), header=None, index_col=False,
                            keep_default_na=False, na_values=[""], dtype=dict(text), skip_blank_lines=False,
                            **EXACT_FLOATS)
     except (ValueError, UnicodeDecodeError, pd.errors.ParserError):
@@ -173,7 +200,7 @@ def _parse_each(lines: list[bytes], columns: Sequence[str], text) -> tuple[pd.Da
     that give one row each, and which did."""
     parts, keep = [], np.zeros(len(lines), dtype=bool)
     for i, line in enumerate(lines):
-        raw = _parse([line], columns, text)
+        raw = _parse(line, columns, text)
         if raw is not None and len(raw) == 1:
             parts.append(raw.astype(object))
             keep[i] = True
@@ -199,9 +226,11 @@ def _numbers(values: pd.Series) -> tuple[np.ndarray, np.ndarray]:
     return numbers, bad
 
 
-def _texts(values: pd.Series) -> np.ndarray:
+def texts(values: pd.Series) -> np.ndarray:
     """A column as an object array of ``str``, None where empty."""
     out = values.to_numpy(dtype=object, na_value=None)
+    if pd.api.types.infer_dtype(out, skipna=True) in ("string", "empty"):
+        return out
     return np.array([None if v is None or v != v else str(v) for v in out], dtype=object)
 
 
@@ -215,29 +244,32 @@ def _bools(values: pd.Series) -> tuple[np.ndarray, np.ndarray]:
 
 def check_rows(raw: pd.DataFrame, params: Sequence[str], metrics: Sequence[str], kinds: Mapping[str, str],
                quoted_end: np.ndarray | None = None) -> tuple[pd.DataFrame, np.ndarray, tuple[int, str] | None]:
-    """Every row of ``raw`` checked (module docstring): ``(clean, broken, foreign)`` -- the columns in the
-    types :func:`~mbs_models.studies.sweep_table.typed` takes (numbers float64, booleans bool, text
-    ``str``/None), which rows are unreadable, and ``(position, why)`` of the first row that is sound but whose
-    parameters are not of their kinds (None if every one is).  ``quoted_end``: whether each row's line
-    ends with a quote (a CSV file; None for Parquet)."""
+    """Every row of ``raw`` checked (module docstring): ``(table, broken, foreign)`` -- the sound rows in the
+    types :func:`~mbs_models.studies.sweep_table.frame` gives rows (parameters float64, bool or text, metrics
+    float64, counts ``Int64``, text ``object`` with None where empty), which rows are unreadable, and
+    ``(position, why)`` of the first row that is sound but whose parameters are not of their kinds (None if
+    every one is).  ``quoted_end``: whether each row's line ends with a quote (a CSV file; None for Parquet)."""
     count = len(raw)
     broken = np.zeros(count, dtype=bool)
-    clean: dict[str, object] = {}
-    status = _texts(raw["status"])
-    present_status = np.array([s is not None for s in status], dtype=bool)
+    clean: dict[str, np.ndarray] = {}
+    status = texts(raw["status"])
+    present_status = pd.notna(status)
     ok = status == "ok"
     failed = present_status & ~ok
-    names = pd.Series(status, dtype=object).str.fullmatch(_CLASS_NAME).fillna(False).to_numpy(dtype=bool)
+    names = np.zeros(count, dtype=bool)   # whether a failed row's status is a class name (each value matched once)
+    if failed.any():
+        named = {value: re.fullmatch(_CLASS_NAME, value) is not None for value in pd.unique(status[failed])}
+        names[failed] = [named[value] for value in status[failed]]
     broken |= ~present_status | (failed & ~names)
-    error = _texts(raw["error"])
-    has_error = np.array([e is not None for e in error], dtype=bool)
+    error = texts(raw["error"])
+    has_error = pd.notna(error)
     broken |= (ok & has_error) | (failed & ~has_error)
     if quoted_end is not None:
         broken |= failed & ~np.asarray(quoted_end, dtype=bool)
     for column in (*metrics, "wall_time"):
         if is_text(column):
-            clean[column] = _texts(raw[column])
-            broken |= failed & (clean[column] != None)  # noqa: E711 - elementwise
+            clean[column] = texts(raw[column])
+            broken |= failed & pd.notna(clean[column])
             continue
         numbers, bad = _numbers(raw[column])
         present = ~np.isnan(numbers)
@@ -262,14 +294,22 @@ def check_rows(raw: pd.DataFrame, params: Sequence[str], metrics: Sequence[str],
             clean[column], bad = _bools(raw[column])
             why = f"column {column!r} does not hold true/false"
         else:
-            clean[column], bad, why = _texts(raw[column]), np.zeros(count, dtype=bool), ""
+            clean[column], bad, why = texts(raw[column]), np.zeros(count, dtype=bool), ""
         sound_but_other = bad & ~broken
         if foreign is None and sound_but_other.any():
             foreign = (int(np.flatnonzero(sound_but_other)[0]), why)
+    keep = ~broken
     columns = [*params, *metrics, *STATUS_COLUMNS]
-    frame = pd.DataFrame({column: clean[column] for column in columns}, columns=columns)
-    return frame, broken, foreign
+    data = {}
+    for column in columns:
+        values = clean[column][keep] if not keep.all() else clean[column]
+        if column not in params and is_count(column):
+            values = pd.array(values, dtype="Int64")
+        elif values.dtype == object:
+            values = pd.Series(values, dtype=object)
+        data[column] = values
+    return pd.DataFrame(data, columns=columns), broken, foreign
 
 
-__all__ = ["Unreadable", "UnreadableRowsWarning", "csv_text", "csv_chunks", "read_header", "check_rows", "is_count", "is_text",
-           "LISTED_LINES", "EXACT_FLOATS"]
+__all__ = ["Unreadable", "UnreadableRowsWarning", "csv_text", "csv_chunks", "line_checks", "read_header",
+           "check_rows", "texts", "is_count", "is_text", "LISTED_LINES", "EXACT_FLOATS"]
