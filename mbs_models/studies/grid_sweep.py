@@ -133,10 +133,11 @@ def run_sweep(scene: Scene, params, *, end_time: float = 10.0, accuracy: str | S
             backend = _backends.SerialBackend()
         elif scheduler is not None:
             backend = _backends.make_backend(None, scheduler)
-        else:   # a pool of no more workers than tasks
+        else:   # a pool of no more workers than tasks (of one, for one task: a crash is then the pool's, not ours)
             requested = _backends.check_workers(workers)
             tasks = math.ceil(pending / (batch_size or _backends.batch_size(pending, requested)))
-            backend = _backends.make_backend(min(requested, tasks))
+            backend = (_backends.SerialBackend() if requested == 1 else
+                       _backends.ProcessBackend(min(requested, tasks)))
         if out is not None:
             file.write_settings(recorded)
         with backend:

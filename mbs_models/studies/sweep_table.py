@@ -38,7 +38,7 @@ import pandas as pd
 from ..outputs import atomic_write_with
 from ..errors import RecoilError, SceneError
 from .point import STATUS_COLUMNS
-from .table_rows import EXACT_FLOATS, Unreadable, check_rows, csv_chunks, csv_text, is_count, is_text, read_header
+from .table_rows import Unreadable, check_rows, csv_chunks, csv_text, is_count, is_text, read_header
 from .table_sort import SortStats
 
 FORMATS = {".csv": "csv", ".parquet": "parquet"}

@@ -747,3 +747,12 @@ def test_temporary_files_a_killed_run_left_are_removed(tmp_path):
         (tmp_path / name).write_text("x")
     run_sweep(model_i(), {"contact.gap": [0.0]}, end_time=0.2, workers=1, progress=False, out=path)
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(kept + ["s.csv", "s.csv.sweep.json"])
+
+
+def test_a_last_point_that_kills_its_worker_runs_in_a_worker_too(tmp_path, monkeypatch):
+    """One point left (a resumed sweep's last, here the only one): with workers=2 it still runs in a worker
+    process -- a pool of one -- so that its crash is a row, not the end of the sweep for good."""
+    monkeypatch.setattr(point_module, "simulate_scene", _killed_at_gap)
+    table = run_sweep(model_i(), {"contact.gap": [0.02]}, end_time=0.2, accuracy="draft", workers=2, progress=False,
+                      out=tmp_path / "one.csv")
+    assert table["status"].tolist() == ["WorkerDied"]
