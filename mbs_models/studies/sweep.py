@@ -6,7 +6,8 @@
   the grid's size); on a local process pool or a Dask cluster.  Its parts: :mod:`.grid` (the points),
   :mod:`.point` (one point as a row; the one call of ``simulate``), :mod:`.backends` (where points run),
   :mod:`.point_set` (the points a file holds), :mod:`.sweep_table` (the table's types and file),
-  :mod:`.table_sort` (the file put in grid order).
+  :mod:`.table_rows` (its rows written and read back, each checked), :mod:`.sweep_lock` (one sweep per
+  file), :mod:`.table_sort` (the file put in grid order).
 * :func:`run_scenes`, :func:`gap_sweep`, :func:`parallel_map`: many scenes (or any function) in worker
   processes, giving :class:`SweepPoint` objects (the validation studies use these).
 
