@@ -173,11 +173,13 @@ def run_points(backend, tasks):
 
 
 def _check_cells(grid) -> None:
-    """SceneError if a parameter's table cell holds a line break (a file's rows are read back line by line)."""
+    """SceneError if a parameter's table cell holds a line break or a NUL (a file's rows are read back line by
+    line, and a line with a NUL is no row)."""
     for key, cells in zip(grid.keys, grid.cells):
         for cell in cells:
-            if isinstance(cell, str) and ("\n" in cell or "\r" in cell):
-                raise SceneError(key, f"{cell!r} holds a line break, which a cell of the table's file cannot hold")
+            if isinstance(cell, str) and any(c in cell for c in "\n\r\0"):
+                raise SceneError(key, f"{cell!r} holds a line break or a NUL, which a cell of the table's file "
+                                      "cannot hold")
 
 
 def _note(say, text: str) -> None:

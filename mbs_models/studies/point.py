@@ -23,6 +23,7 @@ the overrides and the :class:`PointSettings`, build their own model and send bac
 from __future__ import annotations
 
 import math
+import re
 import time
 from dataclasses import dataclass
 from typing import Any, Mapping, Sequence
@@ -56,6 +57,8 @@ TEXT_COLUMNS = ("stop_reason", "status", "error")
 WORKER_DIED = "WorkerDied"
 #: The longest ``error`` message kept (characters; a longer one is cut, ending in "...").
 MAX_ERROR_LENGTH = 1000
+#: Characters an ``error`` message does not keep (a NUL would make its row unreadable).
+_CONTROL = re.compile(r"[\x00-\x1f\x7f]")
 
 
 @dataclass(frozen=True)
@@ -137,7 +140,9 @@ def evaluate_point(scene: Scene, overrides: Mapping[str, Any], settings: PointSe
         metrics = checked_metrics(result_row(result, point_scene))
         wall_time = float(result.wall_time)
     except Exception as exc:  # noqa: BLE001 - every failure of one point is its row (module docstring)
-        return failed_row(scene, overrides, type(exc).__name__, error_text(exc), time.perf_counter() - start)
+        name = type(exc).__name__
+        return failed_row(scene, overrides, name if name.isidentifier() else "Exception", error_text(exc),
+                          time.perf_counter() - start)
     row.update(metrics)
     row.update(wall_time=wall_time if math.isfinite(wall_time) and wall_time >= 0 else time.perf_counter() - start,
                status="ok", error=None)
@@ -154,13 +159,15 @@ def failed_row(scene: Scene, overrides: Mapping[str, Any], status: str, error: s
 
 def error_text(exc: BaseException) -> str:
     """The message of ``exc`` as one line for the ``error`` column: its lines joined with "; ", double quotes
-    made single (a table's ``error`` cell is always quoted: a row cut short shows), at most
-    :data:`MAX_ERROR_LENGTH` characters; the class name if it has no message (or cannot give one)."""
+    made single (a table's ``error`` cell is always quoted: a row cut short shows), other control characters
+    spaces, what UTF-8 cannot hold replaced, at most :data:`MAX_ERROR_LENGTH` characters; the class name if
+    it has no message (or cannot give one)."""
     try:
         text = str(exc)
     except Exception:  # noqa: BLE001 - a broken __str__ must not end the sweep either
         text = ""
     text = "; ".join(line.strip() for line in text.splitlines() if line.strip()).replace('"', "'")
+    text = _CONTROL.sub(" ", text).encode("utf-8", "replace").decode("utf-8")
     if len(text) > MAX_ERROR_LENGTH:
         text = text[:MAX_ERROR_LENGTH - 3] + "..."
     return text or type(exc).__name__

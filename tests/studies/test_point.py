@@ -82,6 +82,7 @@ class _BrokenMessage(Exception):
     (MemoryError(), "MemoryError", "MemoryError"),                                       # no message: the class
     (RecursionError("maximum recursion depth exceeded"), "RecursionError", "maximum recursion depth exceeded"),
     (_BrokenMessage(), "_BrokenMessage", "_BrokenMessage"),
+    (type("no name", (ValueError,), {})("a\x00b\tc \udcff"), "Exception", "a b c ?"),  # what a table cannot hold
 ], ids=lambda v: type(v).__name__ if isinstance(v, BaseException) else None)
 def test_any_exception_of_a_point_is_its_row(monkeypatch, exc, status, error):
     """Whatever a point raises -- while its scene is built or solved -- is its row: the sweep goes on."""
