@@ -23,8 +23,8 @@ whose worker died alone too yields ``lost(part, reason)`` instead of its result 
 its worker is a failed row and every other point runs.  On Dask the scheduler already re-runs a task
 whose worker died (``distributed.scheduler.allowed-failures`` times) before it reports ``KilledWorker``
 -- for every task its worker held, not only the one that killed it; the task is then split, its parts
-submitted again, a part killed again submitted once more and waited for (the others go on), and ``lost``
-if that one is killed too.  Without ``lost`` a death ends the run.
+submitted again, a part killed again kept aside and, once nothing else is in flight, submitted alone, and
+``lost`` if that one is killed too.  Without ``lost`` a death ends the run.
 Whatever kills *every* worker (too little memory for any process) is no point's fault: after
 :data:`DEATHS_IN_A_ROW` lost parts in a row, the last task that finished runs again, alone, and if it
 dies too (or none has finished) the run ends with a SimulationError, those parts not yielded (``_Losses``).
@@ -345,6 +345,7 @@ class DaskBackend(SerialBackend):
             finished.add(future)
 
         self._losses.start(lost, lambda task: self._alone(function, task)[0])
+        suspects: list = []   # parts killed twice: each runs alone at the end
 
         try:
             for future in finished:
@@ -359,13 +360,18 @@ class DaskBackend(SerialBackend):
                     if deaths == 0:
                         for part in (split(task) if split is not None else [task]):
                             submit(part, 1)
-                        continue
-                    ran, result = self._alone(function, task)   # the others in flight go on meanwhile
-                    if not ran:
-                        yield from self._losses.add(task, result)
-                        continue
+                    else:   # run alone once nothing else is in flight (a dying worker strikes all it holds)
+                        suspects.append(task)
+                    continue
                 yield from self._losses.finished(task)
                 yield result
+            for task in suspects:
+                ran, result = self._alone(function, task)
+                if ran:
+                    yield from self._losses.finished(task)
+                    yield result
+                else:
+                    yield from self._losses.add(task, result)
             yield from self._losses.release()
         finally:
             self.client.cancel([f for f in running if not f.done()])
