@@ -3,13 +3,16 @@
     recoil sweep model_i --param absorber.mass=100,500,1000 --param contact.gap=0:0.12:13 --out gaps.csv
 
 Bad keys, specs, values and paths exit 2 with one line naming them, before anything is written, and so does
-a grid of more than 10^6 points without ``--large``; a failing point is a row of the table (``status``,
-``error``) and the sweep goes on; running the same command again resumes (only the points not yet in the
-file run). On a Dask cluster (``--scheduler``) a malformed address exits 2; an address that does not
-answer, a scheduler lost mid-sweep or no worker for ``--worker-timeout`` seconds exits 1 with one line
-saying how many rows the file keeps (the same command resumes). Before the points run, one line on stderr
-says how many there are and about how long they take (measured on a few points spread over the grid: an
-estimate). The table stays in its file: memory does not
+a grid of more than 10^6 points without ``--large``, a file another sweep is writing (it is locked) or
+one with rows but no ``FILE.sweep.json``; a failing point is a row of the table (``status``, ``error``:
+whatever it raised, or a worker process that died on it) and the sweep goes on; running the same command
+again resumes (only the points not yet in the file run; rows the file holds damaged are named in one line
+and run again). A disk that fills up stops the sweep with one line and exit 1, every row written kept. On a
+Dask cluster (``--scheduler``) a malformed address exits 2; an address that does not answer, a scheduler
+lost mid-sweep or no worker for ``--worker-timeout`` seconds exits 1 with one line saying how many rows the
+file keeps (the same command resumes). Before the points run, one line on stderr says how many there are and
+about how long they take (measured on a few points spread over the grid: an estimate). The table stays in
+its file: memory does not
 grow with the grid. ``--set KEY=VALUE`` (``recoil run``, ``recoil validate``) changes fields of the scene
 for one run, with the same keys.
 """
@@ -91,7 +94,8 @@ def run_command(args) -> int:
     from ..scene.overrides import parse_assignment
     from ..studies.grid import GridTooLarge
     from ..studies.sweep import run_sweep
-    from . import EXIT_OK, _resolve_scene
+    from ..studies.sweep_table import SweepWriteError
+    from . import EXIT_FAILED, EXIT_OK, _resolve_scene
 
     scene = _resolve_scene(args.scene)
     params = {}
@@ -110,6 +114,9 @@ def run_command(args) -> int:
         raise exc.with_flag("--large", "--large") from None
     except SceneError as exc:
         raise SceneError(_OPTIONS.get(exc.key, exc.key), exc.message) from None
+    except SweepWriteError as exc:   # a full disk: the rows written are kept, and resume
+        print(f"recoil: error: {exc}", file=sys.stderr)
+        return EXIT_FAILED
     except KeyboardInterrupt:
         print(f"recoil sweep: interrupted; the finished points are in {args.out}: run the same command again "
               "to resume", file=sys.stderr)

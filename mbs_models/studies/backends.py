@@ -17,11 +17,26 @@ next one taken as one finishes, so that what a run holds does not depend on how 
   ``worker_timeout``) stop the run with a :class:`~mbs_models.errors.ClusterError`.  Dask is imported only
   here, and only then (the ``cluster`` extra: ``pip install recoil-mbs[cluster]``).
 
+A worker process that dies (a crash in compiled code, the out-of-memory killer) reports nothing.  Given
+``lost`` (and ``split``), ``run`` does not end there: the tasks the death took (every task of a broken
+local pool) run again, cut into parts (``split(task)``: a sweep's batch point by point) handed out first;
+a part lost a second time runs alone (a pool of one process: a death is then that part's), and a part
+whose worker died alone too yields ``lost(part, reason)`` instead of its result -- so a point that kills
+its worker is a failed row and every other point runs.  On Dask the scheduler already re-runs a task
+whose worker died (``distributed.scheduler.allowed-failures`` times) before it reports ``KilledWorker``
+-- for every task its worker held, not only the one that killed it; the task is then split, its parts
+submitted again, a part killed again kept aside and, once nothing else is in flight, submitted alone, and
+``lost`` if that one is killed too.  Without ``lost`` a death ends the run.
+Whatever kills *every* worker (too little memory for any process) is no point's fault: after
+:data:`DEATHS_IN_A_ROW` lost parts in a row, the last task that finished runs again, alone, and if it
+dies too (or none has finished) the run ends with a SimulationError, those parts not yielded (``_Losses``).
+
 :func:`make_backend` picks one from ``workers``/``scheduler``; :data:`BACKENDS` maps names to classes.
 """
 
 from __future__ import annotations
 
+import collections
 import contextlib
 import itertools
 import math
@@ -29,6 +44,7 @@ import multiprocessing
 import os
 import queue
 import re
+import signal
 import socket
 import sys
 import time
@@ -102,7 +118,11 @@ class SerialBackend:
     name = "serial"
     workers = 1
 
-    def run(self, function: Callable, tasks: Iterable, *, in_flight: int | None = None) -> Iterator[Any]:
+    def run(self, function: Callable, tasks: Iterable, *, in_flight: int | None = None,
+            split: Callable[[Any], list] | None = None, lost: Callable[[Any, str], Any] | None = None
+            ) -> Iterator[Any]:
+        """``function(task)`` of every task, in order (``split``/``lost``: for a worker's death, which cannot
+        happen here: a crash ends this process)."""
         for task in tasks:
             yield function(task)
 
@@ -124,39 +144,169 @@ class ProcessBackend(SerialBackend):
     def __init__(self, workers: int | None = None):
         self.workers = check_workers(workers)
         self._pool: ProcessPoolExecutor | None = None
+        self._losses = _Losses()
 
-    def run(self, function: Callable, tasks: Iterable, *, in_flight: int | None = None) -> Iterator[Any]:
+    def run(self, function: Callable, tasks: Iterable, *, in_flight: int | None = None,
+            split: Callable[[Any], list] | None = None, lost: Callable[[Any, str], Any] | None = None
+            ) -> Iterator[Any]:
         limit = _check_in_flight(in_flight, self.workers)
         tasks = iter(tasks)
-        first = list(itertools.islice(tasks, limit))
-        if not first:
-            return
-        if self._pool is None:
-            self._pool = local_pool(self.workers)
-        pool, finished = self._pool, False
+        retry: collections.deque = collections.deque()   # (part, 1): parts of tasks a death took, first out
+
+        def take():
+            if retry:
+                return retry.popleft()
+            return next(((task, 0) for task in itertools.islice(tasks, 1)), None)
+
+        running: dict = {}   # future -> (task, deaths: how many pool deaths took it)
+        self._losses.start(lost, lambda task: self._alone(function, task)[0])
+        finished = False
         try:
-            running = {pool.submit(function, task) for task in first}
-            del first
-            while running:
-                done, running = wait(running, return_when=FIRST_COMPLETED)
-                for future in done:
-                    result = future.result()
-                    for task in itertools.islice(tasks, 1):
-                        running.add(pool.submit(function, task))
+            while True:
+                broken = False
+                while len(running) < limit and (item := take()) is not None:
+                    if self._pool is None:
+                        self._pool = local_pool(self.workers)
+                    try:
+                        running[self._pool.submit(function, item[0])] = item
+                    except BrokenProcessPool:   # a worker died since the last look
+                        retry.appendleft(item)
+                        broken = True
+                        break
+                if not running and not broken:
+                    break
+                done = wait(running, return_when=FIRST_COMPLETED).done if running else set()
+                results, dead = _collect(done, running)
+                if dead or broken:   # the pool is broken: every task still running is lost with it
+                    if lost is None:
+                        raise BrokenProcessPool
+                    more_results, more_dead = _collect(wait(list(running)).done, running)
+                    results, dead = results + more_results, dead + more_dead
+                    self._drop_pool()
+                for task, result in results:
+                    yield from self._losses.finished(task)
                     yield result
+                for task, deaths in dead:
+                    if deaths == 0:
+                        retry.extend((part, 1) for part in (split(task) if split is not None else [task]))
+                        continue
+                    ran, result = self._alone(function, task)
+                    if ran:
+                        yield from self._losses.finished(task)
+                        yield result
+                    else:
+                        yield from self._losses.add(task, result)
+            yield from self._losses.release()
             finished = True
-        except BrokenProcessPool:
+        except BrokenProcessPool:   # without ``lost``, a death ends the run
             raise SimulationError("a worker process died (killed, or out of memory); the points it had not "
                                   "finished are not in the table: run the same sweep again to resume") from None
         finally:
             if not finished:   # an error, an interrupt or a caller that stopped reading: no work left behind
-                self._pool = None
-                pool.shutdown(wait=True, cancel_futures=True)
+                self._drop_pool()
 
-    def close(self) -> None:
+    @staticmethod
+    def _alone(function: Callable, task: Any) -> tuple[bool, Any]:
+        """``function(task)`` in a pool of its own (one process): ``(True, result)``, or ``(False, why it
+        died)`` if that process dies."""
+        pool = local_pool(1)
+        try:
+            try:
+                return True, pool.submit(function, task).result()
+            except BrokenProcessPool:
+                return False, death_reason(pool)
+        finally:
+            pool.shutdown(wait=True, cancel_futures=True)
+
+    def _drop_pool(self) -> None:
         if self._pool is not None:
             pool, self._pool = self._pool, None
             pool.shutdown(wait=True, cancel_futures=True)
+
+    def close(self) -> None:
+        self._drop_pool()
+
+
+#: Parts in a row whose worker died even alone, before the backend checks that its workers can run at all.
+DEATHS_IN_A_ROW = 8
+
+
+class _Losses:
+    """The results ``lost(part, reason)`` of parts whose worker died even alone (:meth:`add`), held back while
+    it is not known whether the parts killed their workers or something kills every worker (too little
+    memory for any process, a broken installation: no point's fault).  They are yielded once a task
+    finishes (:meth:`finished`) or the run ends; :data:`DEATHS_IN_A_ROW` of them in a row make the backend
+    ``rerun`` (alone) the last task that finished: if it finishes again the parts were at fault and their
+    results are yielded, else -- or with no task finished yet -- the run ends (SimulationError), none of
+    them yielded: they run again when the sweep resumes."""
+
+    def __init__(self):
+        self.lost = self.rerun = None
+        self.held: list = []
+        self.canary: Any = None   # the last task that finished: it can run
+
+    def start(self, lost: Callable[[Any, str], Any] | None, rerun: Callable[[Any], bool]) -> None:
+        """A run starts (nothing held from a run that ended early)."""
+        self.lost, self.rerun, self.held = lost, rerun, []
+
+    def finished(self, task: Any) -> list:
+        """A task finished: workers can run; the held results, to yield before its own."""
+        self.canary = task
+        return self.release()
+
+    def add(self, task: Any, reason: str) -> list:
+        """A part's worker died even alone: the results to yield now (none while held)."""
+        self.held.append(self.lost(task, reason))
+        if len(self.held) < DEATHS_IN_A_ROW:
+            return []
+        if self.canary is not None and self.rerun(self.canary):
+            return self.release()
+        count, self.held = len(self.held), []
+        test = "a point that ran before died too" if self.canary is not None else "no point has run yet"
+        raise SimulationError(f"worker processes died on {count} points in a row, each run alone (the last: "
+                              f"{reason}), and {test}: something kills every worker (too little memory?); the "
+                              "rows written are kept: run the same sweep again to resume")
+
+    def release(self) -> list:
+        held, self.held = self.held, []
+        return held
+
+
+def _collect(done, running: dict) -> tuple[list, list]:
+    """``(task, result)`` of the finished futures ``done`` (removed from ``running``), and the ``(task,
+    deaths)`` of those a broken pool took; any other exception is raised."""
+    results, dead = [], []
+    for future in done:
+        task, deaths = running.pop(future)
+        if isinstance(future.exception(), BrokenProcessPool):
+            dead.append((task, deaths))
+        else:
+            results.append((task, future.result()))
+    return results, dead
+
+
+def death_reason(pool: ProcessPoolExecutor) -> str:
+    """Why the worker of a one-process pool died, for the ``error`` of its point: the signal or exit code."""
+    codes = []
+    for process in list((getattr(pool, "_processes", None) or {}).values()):
+        try:
+            process.join(timeout=5.0)   # the pool reports its death before it has reaped the process
+        except (AssertionError, OSError, ValueError):
+            pass
+        if process.exitcode:
+            codes.append(process.exitcode)
+    how = ""
+    if codes and codes[0] < 0:
+        try:
+            name = signal.Signals(-codes[0]).name
+        except ValueError:
+            name = f"signal {-codes[0]}"
+        cause = {"SIGKILL": " (the out-of-memory killer? a user?)", "SIGSEGV": " (a crash in compiled code)",
+                 "SIGBUS": " (a crash in compiled code)", "SIGABRT": " (an abort in compiled code)"}.get(name, "")
+        how = f" of {name}{cause}"
+    elif codes:
+        how = f" (exit code {codes[0]})"
+    return f"its worker process died{how} each of the 3 times it ran it (in its batch, again, then alone)"
 
 
 #: Seconds to reach a Dask scheduler (its port answering, then Dask's handshake) before giving up.
@@ -202,38 +352,63 @@ class DaskBackend(SerialBackend):
                 raise
             self.address = scheduler
         self._without_workers: float | None = None   # time.monotonic() since when the cluster has had none
+        self._losses = _Losses()
         try:
             self.workers = max(1, self._count_workers())
         except BaseException:
             self.close()
             raise
 
-    def run(self, function: Callable, tasks: Iterable, *, in_flight: int | None = None) -> Iterator[Any]:
+    def run(self, function: Callable, tasks: Iterable, *, in_flight: int | None = None,
+            split: Callable[[Any], list] | None = None, lost: Callable[[Any, str], Any] | None = None
+            ) -> Iterator[Any]:
+        distributed = import_distributed()
         limit = _check_in_flight(in_flight, self.workers)
         tasks = iter(tasks)
         first = list(itertools.islice(tasks, limit))
         if not first:
             return
         finished: queue.SimpleQueue = queue.SimpleQueue()   # futures as they end (done, failed or cancelled)
-        running: set = set()
+        running: dict = {}   # future -> (task, deaths)
         self._without_workers = None
 
-        def submit(task) -> None:
+        def submit(task, deaths) -> None:
             future = self.client.submit(function, task, pure=False)
-            running.add(future)
+            running[future] = (task, deaths)
             future.add_done_callback(finished.put)
 
+        self._losses.start(lost, lambda task: self._alone(function, task)[0])
+        suspects: list = []   # parts killed twice: each runs alone at the end
         try:
             for task in first:
-                submit(task)
+                submit(task, 0)
             del first
             while running:
                 future = self._next(finished)
-                running.discard(future)
-                result = self._result(future)
-                for task in itertools.islice(tasks, 1):
-                    submit(task)
+                task, deaths = running.pop(future)
+                for more in itertools.islice(tasks, 1):
+                    submit(more, 0)
+                try:
+                    result = self._result(future)
+                except distributed.KilledWorker as exc:   # it ran on allowed-failures + 1 workers, all died
+                    if lost is None:
+                        raise self._killed(exc) from None
+                    if deaths == 0:
+                        for part in (split(task) if split is not None else [task]):
+                            submit(part, 1)
+                    else:   # run alone once nothing else is in flight (a dying worker strikes all it holds)
+                        suspects.append(task)
+                    continue
+                yield from self._losses.finished(task)
                 yield result
+            for task in suspects:
+                ran, result = self._alone(function, task)
+                if ran:
+                    yield from self._losses.finished(task)
+                    yield result
+                else:
+                    yield from self._losses.add(task, result)
+            yield from self._losses.release()
         except ClusterError:
             running.clear()   # nothing to cancel: the scheduler may be gone (a request would wait for it)
             raise
@@ -254,7 +429,8 @@ class DaskBackend(SerialBackend):
             return future
 
     def _result(self, future) -> Any:
-        """The future's result; its task's own error as it is; a fault of the cluster as a ClusterError.
+        """The future's result; its task's own error (and Dask's ``KilledWorker``: the caller decides) as it is;
+        a fault of the cluster as a ClusterError.
 
         Fetching a result waits for ever if the worker holding it dies meanwhile (Dask computes it again once
         it has a worker), so it is fetched by a thread of its own, looked at every :data:`CLUSTER_POLL` s; a
@@ -270,9 +446,6 @@ class DaskBackend(SerialBackend):
                 if fetch.done():   # the task's own
                     raise
                 self._check_cluster()
-            except import_distributed().KilledWorker as exc:
-                raise ClusterError(f"Dask workers kept dying while running one task (killed, out of memory?), "
-                                   f"and the scheduler {self.address} gave it up: {_first_line(exc)}") from None
             except OSError:   # the connection to the scheduler broke while fetching (before the client knows)
                 if future.status == "error":   # the task's own
                     raise
@@ -281,6 +454,11 @@ class DaskBackend(SerialBackend):
                 if future.cancelled():
                     raise self._lost() from None
                 raise
+
+    def _killed(self, exc) -> ClusterError:
+        """The error for a task whose workers kept dying (Dask's ``KilledWorker``) when no ``lost`` is given."""
+        return ClusterError(f"Dask workers kept dying while running one task (killed, out of memory?), and the "
+                            f"scheduler {self.address} gave it up: {_first_line(exc)}")
 
     def _lost(self) -> ClusterError:
         """The error for a cancelled task: the client cancels them all when it loses its scheduler."""
@@ -320,6 +498,18 @@ class DaskBackend(SerialBackend):
         if self._without_workers is not None:
             self._without_workers = None
             self.say(f"dask: the scheduler {self.address} has workers again; going on")
+
+    def _alone(self, function: Callable, task: Any) -> tuple[bool, Any]:
+        """``function(task)`` submitted again and waited for: ``(True, result)``, or ``(False, why)`` if the
+        scheduler reports its workers killed again."""
+        distributed = import_distributed()
+        finished: queue.SimpleQueue = queue.SimpleQueue()
+        future = self.client.submit(function, task, pure=False)
+        future.add_done_callback(finished.put)
+        try:
+            return True, self._result(self._next(finished))
+        except distributed.KilledWorker as exc:
+            return False, f"the Dask workers running it died each time the scheduler tried it ({type(exc).__name__})"
 
     def close(self) -> None:
         if self._own:
@@ -532,4 +722,4 @@ def make_backend(workers: int | None = None, scheduler: Any = None, worker_timeo
 __all__ = ["BACKENDS", "SerialBackend", "ProcessBackend", "DaskBackend", "make_backend", "check_backend", "batch_size",
            "in_flight", "default_workers", "check_workers", "check_scheduler", "check_worker_timeout", "connect",
            "close_quietly", "silence_distributed", "import_distributed", "exit_with_parent", "local_pool",
-           "CONNECT_TIMEOUT", "WORKER_TIMEOUT", "CLUSTER_POLL"]
+           "death_reason", "CONNECT_TIMEOUT", "WORKER_TIMEOUT", "CLUSTER_POLL", "DEATHS_IN_A_ROW"]

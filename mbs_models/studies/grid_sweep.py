@@ -19,8 +19,10 @@ would not do.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import sys
+import warnings
 from typing import Any, Callable, Iterator, Sequence
 
 import numpy as np
@@ -48,12 +50,14 @@ def run_sweep(scene: Scene, params, *, end_time: float = 10.0, accuracy: str | S
     in grid order: the parameters (a column per key), every scalar metric
     (:func:`~mbs_models.studies.point.metric_columns`), ``wall_time`` (s), ``status`` (``"ok"`` or the
     error's class) and ``error`` (the message).  A point whose combination of values is invalid
-    (SceneError) or whose solve fails (SimulationError) is a row with its error; the sweep goes on.
+    (SceneError), whose solve fails (SimulationError) or that raises anything else (an OverflowError of an
+    extreme value...) is a row with its error, and so is a point whose worker process dies each time it runs
+    it (status ``WorkerDied``, after a retry: :mod:`.backends`); the sweep goes on.
 
     ``large``: a grid of more than :data:`~mbs_models.studies.grid.MAX_POINTS` (10^6) points is refused
     (:class:`~mbs_models.studies.grid.GridTooLarge`, a SceneError of key ``large``) unless ``large=True``.
     ``table=False`` (with ``out``) keeps the table in its file only and returns the summary (a dict:
-    ``points``, ``resumed``, ``run``, ``failed``, ``out`` and ``failures``, the first
+    ``points``, ``resumed``, ``run``, ``failed``, ``out``, ``unreadable`` and ``failures``, the first
     :data:`SUMMARY_FAILURES` failed points): memory then does not depend on the grid's size.
 
     ``workers``: a local process pool of that many processes (default: every CPU; 1 runs here);
@@ -67,7 +71,13 @@ def run_sweep(scene: Scene, params, *, end_time: float = 10.0, accuracy: str | S
     the end, the file holds the table in grid order.  If ``out`` already holds rows of the same sweep, only
     the points not yet in it run (a killed sweep resumes; the resumed table equals an uninterrupted one
     but for ``wall_time``); ``FILE.sweep.json`` beside it records the scene and settings, and a file
-    computed with others is refused.  ``progress``: a tqdm bar on a terminal (rate, ETA), False for none, or a
+    computed with others -- or holding rows without that record -- is refused.  Every row read back is
+    checked (:mod:`.table_rows`): an unreadable one (cut short, a second header, a cell that is no number)
+    is dropped and its point runs again, in one line (``t.csv: 3 rows unreadable (line 17, 18, 40): their
+    points run again``: to ``announce``, else an :class:`~.table_rows.UnreadableRowsWarning`).  While it
+    runs the sweep holds ``FILE.lock`` (:mod:`.sweep_lock`): another sweep on the same file is refused.  A
+    file that cannot be written (a full disk) raises :class:`~.sweep_table.SweepWriteError`, every row
+    written kept.  ``progress``: a tqdm bar on a terminal (rate, ETA), False for none, or a
     callable ``progress(done, total)``.  ``announce``: where the line saying how many points and about how
     long goes (:func:`announcement`): a callable taking the line, False for nowhere, None (default) for
     stderr when the tqdm bar is shown.  ``end_time``, ``accuracy``, ``stop_when_final`` and
@@ -75,7 +85,7 @@ def run_sweep(scene: Scene, params, *, end_time: float = 10.0, accuracy: str | S
     (default: about four tasks per worker, at most 16 points each).
 
     The returned table's ``attrs["sweep"]`` holds ``points``, ``resumed`` (rows taken from ``out``),
-    ``run``, ``failed`` and ``out``.  Bad keys, specs, values no point accepts, arguments or files raise
+    ``run``, ``failed``, ``out`` and ``unreadable`` (rows of ``out`` dropped).  Bad keys, specs, values no point accepts, arguments or files raise
     :class:`SceneError` before anything is written.
     """
     from ..engine.accuracy import solver_settings_for
@@ -84,7 +94,8 @@ def run_sweep(scene: Scene, params, *, end_time: float = 10.0, accuracy: str | S
     from ..engine.unit_slips import warn_unit_slips
     from . import backends as _backends
     from .grid import MAX_POINTS, make_grid
-    from .point import PointSettings, evaluate_batch, metric_columns
+    from .point import PointSettings, metric_columns
+    from .sweep_lock import SweepLock
     from .sweep_table import SweepFile, param_kinds
 
     if not isinstance(scene, Scene):
@@ -104,50 +115,85 @@ def run_sweep(scene: Scene, params, *, end_time: float = 10.0, accuracy: str | S
         raise SceneError("table", "table=False keeps the table in its file only: give out= as well")
     params_columns, metrics = list(grid.keys), metric_columns(scene)
     kinds = param_kinds(params_columns, grid.cells)
-    if out is not None:
-        file = SweepFile(out, params_columns, metrics, kinds=kinds)
-        recorded = _settings_record(scene, settings)
-        file.check_settings(recorded)
-        sink: _Sink = _FileSink(file, grid)
-    else:
-        sink = _MemorySink(grid, metrics, kinds)
-    pending = grid.size - sink.done.count
-    if not pending:
-        backend = _backends.SerialBackend()
-    elif scheduler is not None:
-        backend = _backends.make_backend(None, scheduler, worker_timeout)
-    else:   # a pool of no more workers than tasks
-        requested = _backends.check_workers(workers)
-        tasks = math.ceil(pending / (batch_size or _backends.batch_size(pending, requested)))
-        backend = _backends.make_backend(min(requested, tasks))
-    if out is not None:
-        file.write_settings(recorded)
     say = _announcer(announce, progress)
-    with backend:
-        size = batch_size or _backends.batch_size(pending, backend.workers)
-        bar = None
-        try:
-            probed = probe_indices(sink.done, grid, min(PROBE_POINTS, math.ceil(pending / 10)))
-            seconds = _probe(backend, scene, settings, grid, probed, sink)
-            if say is not None:
-                say(announcement(grid, sink.resumed, pending, backend.workers, seconds, len(probed),
-                                 where=None if out is None else str(out)))
-            bar = _progress_bar(progress, grid.size, sink.resumed)
-            bar(len(probed))
-            missing = (index for index in sink.done.missing(grid.size) if index not in probed)
-            for batch in backend.run(evaluate_batch, _tasks(scene, settings, grid, missing, size)):
-                sink.add(batch)
-                bar(len(batch))
-        except ClusterError as exc:   # the rows so far are kept: say how many, and where
-            sink.abandon()
-            raise _stopped(exc, sink.resumed + sink.run, grid.size, out) from None
-        except BaseException:
-            sink.abandon()
-            raise
-        finally:
-            if bar is not None:
-                bar.close()
-    return sink.result(table)
+    with contextlib.ExitStack() as held:
+        if out is not None:
+            _check_cells(grid)
+            file = SweepFile(out, params_columns, metrics, kinds=kinds)
+            held.enter_context(SweepLock(file.path))   # one sweep per file: another one is refused here
+            file.clean_temporaries()                    # what a killed run's rewrite left
+            recorded = _settings_record(scene, settings)
+            file.check_settings(recorded)
+            sink: _Sink = _FileSink(file, grid)
+            for unreadable in sink.unreadable:
+                _note(say, unreadable.text())
+        else:
+            sink = _MemorySink(grid, metrics, kinds)
+        pending = grid.size - sink.done.count
+        if not pending:
+            backend = _backends.SerialBackend()
+        elif scheduler is not None:
+            backend = _backends.make_backend(None, scheduler, worker_timeout)
+        else:   # a pool of no more workers than tasks (of one, for one task: a crash is then the pool's, not ours)
+            requested = _backends.check_workers(workers)
+            tasks = math.ceil(pending / (batch_size or _backends.batch_size(pending, requested)))
+            backend = (_backends.SerialBackend() if requested == 1 else
+                       _backends.ProcessBackend(min(requested, tasks)))
+        if out is not None:
+            file.write_settings(recorded)
+        with backend:
+            size = batch_size or _backends.batch_size(pending, backend.workers)
+            bar = None
+            try:
+                probed = probe_indices(sink.done, grid, min(PROBE_POINTS, math.ceil(pending / 10)))
+                seconds = _probe(backend, scene, settings, grid, probed, sink)
+                if say is not None:
+                    say(announcement(grid, sink.resumed, pending, backend.workers, seconds, len(probed),
+                                     where=None if out is None else str(out)))
+                bar = _progress_bar(progress, grid.size, sink.resumed)
+                bar(len(probed))
+                missing = (index for index in sink.done.missing(grid.size) if index not in probed)
+                for batch in run_points(backend, _tasks(scene, settings, grid, missing, size)):
+                    sink.add(batch)
+                    bar(len(batch))
+            except ClusterError as exc:   # the rows so far are kept: say how many, and where
+                sink.abandon()
+                raise _stopped(exc, sink.resumed + sink.run, grid.size, out) from None
+            except BaseException:
+                sink.abandon()
+                raise
+            finally:
+                if bar is not None:
+                    bar.close()
+        return sink.result(table)
+
+
+def run_points(backend, tasks):
+    """``backend.run`` of :func:`~mbs_models.studies.point.evaluate_batch` over ``tasks``, a point whose worker
+    dies a failed row (:func:`~mbs_models.studies.point.split_batch`, :func:`~.point.lost_batch`)."""
+    from .point import evaluate_batch, lost_batch, split_batch
+
+    return backend.run(evaluate_batch, tasks, split=split_batch, lost=lost_batch)
+
+
+def _check_cells(grid) -> None:
+    """SceneError if a parameter's table cell holds a line break or a NUL (a file's rows are read back line by
+    line, and a line with a NUL is no row)."""
+    for key, cells in zip(grid.keys, grid.cells):
+        for cell in cells:
+            if isinstance(cell, str) and any(c in cell for c in "\n\r\0"):
+                raise SceneError(key, f"{cell!r} holds a line break or a NUL, which a cell of the table's file "
+                                      "cannot hold")
+
+
+def _note(say, text: str) -> None:
+    """A line about the table (rows dropped): where the announcement goes, else a warning."""
+    if say is not None:
+        say(text)
+    else:
+        from .table_rows import UnreadableRowsWarning
+
+        warnings.warn(text, UnreadableRowsWarning, stacklevel=3)
 
 
 def _stopped(error: ClusterError, rows: int, points: int, out) -> ClusterError:
@@ -200,11 +246,9 @@ def probe_indices(done, grid, count: int) -> list[int]:
 def _probe(backend, scene: Scene, settings, grid, indices: Sequence[int], sink) -> float | None:
     """Run the points ``indices`` (one per task, together) into ``sink``; the mean wall time (s) of their
     solves, None if none solved."""
-    from .point import evaluate_batch
-
     times = []
     tasks = [(scene, settings, [(index, grid.point(index))]) for index in indices]
-    for batch in backend.run(evaluate_batch, tasks):
+    for batch in run_points(backend, tasks):
         sink.add(batch)
         times += [row["wall_time"] for _, row in batch if row["status"] == "ok"]
     return sum(times) / len(times) if times else None
@@ -288,6 +332,7 @@ class _Sink:
         from .point_set import PointSet
 
         self.grid, self.done, self.resumed, self.run = grid, PointSet(), 0, 0
+        self.unreadable: list = []   # per file read, its rows dropped (table_rows.Unreadable)
 
     def labelled(self, batch) -> list[dict]:
         rows = []
@@ -301,7 +346,8 @@ class _Sink:
         pass
 
     def summary(self, failed: int, out) -> dict[str, Any]:
-        return {"points": self.grid.size, "resumed": self.resumed, "run": self.run, "failed": failed, "out": out}
+        return {"points": self.grid.size, "resumed": self.resumed, "run": self.run, "failed": failed, "out": out,
+                "unreadable": sum(u.count for u in self.unreadable)}
 
 
 class _MemorySink(_Sink):
@@ -349,6 +395,9 @@ class _FileSink(_Sink):
             self._follow(indices)
             self.tally.add(chunk[new])
         self.resumed = self.done.count
+        self.unreadable = list(self.file.unreadable)
+        if self.unreadable:   # the rewrite at the end leaves them out
+            self.in_order = False
 
     def _follow(self, indices: np.ndarray) -> None:
         """Whether the file's rows, in file order, are still strictly increasing in grid index."""
@@ -374,11 +423,17 @@ class _FileSink(_Sink):
 
     def abandon(self) -> None:
         """A Parquet table takes its journal's rows (readable with the others); a CSV table keeps its rows as
-        they are (the next run puts them in order)."""
-        if self.file.format == "parquet":
-            self.file.finish(self.index_of)
-        else:
-            self.file.sync()
+        they are (the next run puts them in order).  Nothing raised: the run is ending on another error (a full
+        disk leaves the journal, which the next run reads)."""
+        from ..errors import RecoilError
+
+        try:
+            if self.file.format == "parquet":
+                self.file.finish(self.index_of)
+            else:
+                self.file.sync()
+        except (RecoilError, OSError):
+            pass
 
     def result(self, table: bool):
         self._finish()

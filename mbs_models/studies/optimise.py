@@ -27,8 +27,8 @@ the objective and the constraints are given to scipy *vectorised* (``vectorized=
 batch through the backend, and the objective reads the same simulations from a cache (each point is
 simulated once).
 
-A point whose solve fails (or whose scene is refused, or that lacks a value of a metric) is
-**infeasible**, never a crash: it violates the implicit constraint ``solved <= 0`` by 1 and every
+A point whose solve fails (or whose scene is refused, or that raises anything else, or whose worker
+process dies, or that lacks a value of a metric) is **infeasible**, never a crash: it violates the implicit constraint ``solved <= 0`` by 1 and every
 metric constraint by infinity, so any solved point beats it; its row keeps the error.  If no feasible
 point is found, :attr:`OptimisationResult.feasible` is False and the reported design is the least
 violating one.
@@ -260,7 +260,7 @@ class _Evaluations:
     def rows_for(self, xs: np.ndarray) -> list[dict[str, Any]]:
         """The rows of the points ``xs`` (shape (S, N)), simulating the new ones in one parallel batch."""
         from .backends import batch_size
-        from .point import evaluate_batch
+        from .grid_sweep import run_points
 
         points = [tuple(float(v) for v in x) for x in np.atleast_2d(xs)]
         new = list(dict.fromkeys(p for p in points if p not in self.cache))
@@ -269,7 +269,7 @@ class _Evaluations:
             indexed = [(i, dict(zip(self.keys, p))) for i, p in enumerate(new)]
             tasks = [(self.scene, self.settings, indexed[i:i + size]) for i in range(0, len(indexed), size)]
             done: dict[int, dict[str, Any]] = {}
-            for batch in self.backend.run(evaluate_batch, tasks):
+            for batch in run_points(self.backend, tasks):   # a point whose worker dies: a failed row
                 done.update(batch)
             for i, p in enumerate(new):
                 row = done[i]

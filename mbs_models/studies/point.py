@@ -4,9 +4,17 @@
 sweeps of :mod:`.sweep` and the grid sweeps both go through it).  :func:`evaluate_point` applies the
 overrides (:func:`~mbs_models.scene.overrides.apply_overrides`), simulates and returns the row: the
 parameters, every scalar metric (:func:`metric_columns`), ``wall_time`` (s), ``status`` (``"ok"`` or the
-error's class) and ``error`` (its message, None when ok).  A :class:`~mbs_models.errors.SceneError` (an
-invalid combination of values) or :class:`~mbs_models.errors.SimulationError` (a failed solve) is
-recorded in the row; any other exception is a bug and propagates.
+error's class) and ``error`` (its message on one line, None when ok).  Whatever goes wrong at a point is
+recorded in its row, and the sweep goes on: a :class:`~mbs_models.errors.SceneError` (an invalid
+combination of values), a :class:`~mbs_models.errors.SimulationError` (a failed solve) and any other
+exception (an ``OverflowError`` of an extreme value, a ``MemoryError``, a ``RecursionError``, a bug: one
+point must not end a sweep of thousands), raised while the scene is built, solved or its row made; a
+metric that is not a finite number is a SimulationError (a NaN must never pass as a result).
+``KeyboardInterrupt`` and ``SystemExit`` do end the sweep.
+
+A point whose worker process dies (a crash in the solver, the out-of-memory killer) cannot report
+anything: the backend runs it again (:mod:`.backends`), and :func:`lost_batch` gives the rows of a point
+whose worker died each time -- status :data:`WORKER_DIED`.
 
 Everything here is module-level and picklable: worker processes and Dask workers receive the base scene,
 the overrides and the :class:`PointSettings`, build their own model and send back plain rows.
@@ -14,12 +22,13 @@ the overrides and the :class:`PointSettings`, build their own model and send bac
 
 from __future__ import annotations
 
+import math
+import re
 import time
 from dataclasses import dataclass
 from typing import Any, Mapping, Sequence
 
 from ..engine.accuracy import SolverSettings
-from ..errors import RecoilError
 from ..scene import Scene
 from ..scene.overrides import apply_overrides
 
@@ -44,6 +53,12 @@ STATUS_COLUMNS = ("wall_time", "status", "error")
 COUNT_COLUMNS = ("impacts", "steps")
 #: Columns holding text.
 TEXT_COLUMNS = ("stop_reason", "status", "error")
+#: ``status`` of a point whose worker process died every time it ran it (:func:`lost_batch`).
+WORKER_DIED = "WorkerDied"
+#: The longest ``error`` message kept (characters; a longer one is cut, ending in "...").
+MAX_ERROR_LENGTH = 1000
+#: Characters an ``error`` message does not keep (a NUL would make its row unreadable).
+_CONTROL = re.compile(r"[\x00-\x1f\x7f]")
 
 
 @dataclass(frozen=True)
@@ -113,20 +128,74 @@ def evaluate_point(scene: Scene, overrides: Mapping[str, Any], settings: PointSe
     """The row of one point: ``overrides`` (dotted key -> value) applied to ``scene``, simulated.
 
     Keys of the row: the override keys (their values as given), :func:`metric_columns`, then
-    ``wall_time`` (s: the solve's, or the time to fail), ``status`` and ``error``.
+    ``wall_time`` (s: the solve's, or the time to fail), ``status`` and ``error``.  Any exception (module
+    docstring) gives the row of a failed point: every metric None, ``status`` the exception's class,
+    ``error`` its message on one line (:func:`error_text`).
     """
     row: dict[str, Any] = dict(overrides)
     start = time.perf_counter()
     try:
         point_scene = apply_overrides(scene, overrides)
         result = simulate_scene(point_scene, settings)
-    except RecoilError as exc:
-        row.update({column: None for column in metric_columns(scene)})
-        row.update(wall_time=time.perf_counter() - start, status=type(exc).__name__, error=str(exc))
-        return row
-    row.update(result_row(result, point_scene))
-    row.update(wall_time=result.wall_time, status="ok", error=None)
+        metrics = checked_metrics(result_row(result, point_scene))
+        wall_time = float(result.wall_time)
+    except Exception as exc:  # noqa: BLE001 - every failure of one point is its row (module docstring)
+        name = type(exc).__name__
+        return failed_row(scene, overrides, name if name.isidentifier() else "Exception", error_text(exc),
+                          time.perf_counter() - start)
+    row.update(metrics)
+    row.update(wall_time=wall_time if math.isfinite(wall_time) and wall_time >= 0 else time.perf_counter() - start,
+               status="ok", error=None)
     return row
+
+
+def failed_row(scene: Scene, overrides: Mapping[str, Any], status: str, error: str, wall_time: float) -> dict:
+    """The row of a failed point: the overrides, every metric None, ``wall_time`` (s), ``status``, ``error``."""
+    row: dict[str, Any] = dict(overrides)
+    row.update({column: None for column in metric_columns(scene)})
+    row.update(wall_time=wall_time, status=status, error=error)
+    return row
+
+
+def error_text(exc: BaseException) -> str:
+    """The message of ``exc`` as one line for the ``error`` column: its lines joined with "; ", double quotes
+    made single (a table's ``error`` cell is always quoted: a row cut short shows), other control characters
+    spaces, what UTF-8 cannot hold replaced, at most :data:`MAX_ERROR_LENGTH` characters; the class name if
+    it has no message (or cannot give one)."""
+    try:
+        text = str(exc)
+    except Exception:  # noqa: BLE001 - a broken __str__ must not end the sweep either
+        text = ""
+    text = "; ".join(line.strip() for line in text.splitlines() if line.strip()).replace('"', "'")
+    text = _CONTROL.sub(" ", text).encode("utf-8", "replace").decode("utf-8")
+    if len(text) > MAX_ERROR_LENGTH:
+        text = text[:MAX_ERROR_LENGTH - 3] + "..."
+    return text or type(exc).__name__
+
+
+def checked_metrics(row: dict[str, Any]) -> dict[str, Any]:
+    """``row`` (a result's metric columns, :func:`result_row`) with every value a plain number or None: a count
+    a whole number >= 0, any other metric a finite float, ``stop_reason`` text; SimulationError naming the
+    first metric that is not (a NaN or an infinity is a failed solve, never a result)."""
+    from ..errors import SimulationError
+
+    checked: dict[str, Any] = {}
+    for name, value in row.items():
+        if value is None:
+            checked[name] = None
+        elif name in TEXT_COLUMNS:
+            checked[name] = str(value)
+        elif name in COUNT_COLUMNS or name.rsplit(".", 1)[-1] in COUNT_COLUMNS:
+            number = float(value)
+            if isinstance(value, bool) or not math.isfinite(number) or number != int(number) or number < 0:
+                raise SimulationError(f"{name}: the result's count is {value!r}, not a whole number >= 0")
+            checked[name] = int(value)
+        else:
+            number = float(value)
+            if not math.isfinite(number):
+                raise SimulationError(f"{name}: the result's value is {number!r}, not a finite number")
+            checked[name] = number
+    return checked
 
 
 def evaluate_batch(task: tuple[Scene, PointSettings, Sequence[tuple[int, Mapping[str, Any]]]]
@@ -137,5 +206,20 @@ def evaluate_batch(task: tuple[Scene, PointSettings, Sequence[tuple[int, Mapping
     return [(index, evaluate_point(scene, overrides, settings)) for index, overrides in points]
 
 
+def split_batch(task: tuple) -> list[tuple]:
+    """A task of :func:`evaluate_batch` as one task per point: what a backend retries, point by point, when the
+    worker running the task died."""
+    scene, settings, points = task
+    return [(scene, settings, [point]) for point in points]
+
+
+def lost_batch(task: tuple, reason: str) -> list[tuple[int, dict]]:
+    """The result of a task of :func:`evaluate_batch` whose worker died each time it ran (``reason`` says how):
+    each point a failed row of status :data:`WORKER_DIED`."""
+    scene, _settings, points = task
+    return [(index, failed_row(scene, overrides, WORKER_DIED, reason, 0.0)) for index, overrides in points]
+
+
 __all__ = ["PointSettings", "simulate_scene", "evaluate_point", "evaluate_batch", "metric_columns", "result_row",
-           "SCALAR_METRICS", "STATUS_COLUMNS", "COUNT_COLUMNS", "TEXT_COLUMNS"]
+           "failed_row", "error_text", "checked_metrics", "split_batch", "lost_batch", "SCALAR_METRICS",
+           "STATUS_COLUMNS", "COUNT_COLUMNS", "TEXT_COLUMNS", "WORKER_DIED", "MAX_ERROR_LENGTH"]

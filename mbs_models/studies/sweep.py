@@ -6,7 +6,8 @@
   the grid's size); on a local process pool or a Dask cluster.  Its parts: :mod:`.grid` (the points),
   :mod:`.point` (one point as a row; the one call of ``simulate``), :mod:`.backends` (where points run),
   :mod:`.point_set` (the points a file holds), :mod:`.sweep_table` (the table's types and file),
-  :mod:`.table_sort` (the file put in grid order).
+  :mod:`.table_rows` (its rows written and read back, each checked), :mod:`.sweep_lock` (one sweep per
+  file), :mod:`.table_sort` (the file put in grid order).
 * :func:`run_scenes`, :func:`gap_sweep`, :func:`parallel_map`: many scenes (or any function) in worker
   processes, giving :class:`SweepPoint` objects (the validation studies use these).
 
@@ -65,13 +66,15 @@ class SweepPoint:
 
 
 def _run_one(job: tuple[Scene, float, str | SolverSettings, tuple[str, ...]]) -> SweepPoint:
-    from .point import PointSettings, simulate_scene
+    from .point import PointSettings, error_text, simulate_scene
 
     scene, end_time, accuracy, stop_when_final = job
     try:
         result = simulate_scene(scene, PointSettings(end_time, accuracy, stop_when_final))
     except SimulationError as exc:
         return SweepPoint(scene, None, None, None, None, None, 0.0, error=str(exc))
+    except Exception as exc:  # noqa: BLE001 - one scene must not end the sweep (as a grid point: studies.point)
+        return SweepPoint(scene, None, None, None, None, None, 0.0, error=f"{type(exc).__name__}: {error_text(exc)}")
     return SweepPoint(scene, result.max_barrel_displacement, result.time_of_max_barrel_displacement,
                       result.peak_contact_force, result.max_absorber_velocity,
                       None if result.impacts is None else len(result.impacts), result.wall_time,
@@ -85,7 +88,8 @@ def run_scenes(scenes: Sequence[Scene], end_time: float = 10.0, accuracy: str | 
     """Simulate every scene (in order) and return one :class:`SweepPoint` each.
 
     ``workers=1`` runs in this process; otherwise a process pool of ``workers`` (default: all CPUs)
-    is used.  A failed solve does not stop the sweep: its point carries ``error`` instead of values.
+    is used.  A failed solve (or any other exception of one scene) does not stop the sweep: its point carries
+    ``error`` instead of values.
     ``stop_when_final`` is passed to :func:`~mbs_models.simulate`: each run stops once the named
     metrics are proven final (the others are then None in its point).
     """

@@ -2,7 +2,7 @@
 
 One row per point: the parameters (one column per dotted key), the metrics
 (:func:`~mbs_models.studies.point.metric_columns`), ``wall_time``, ``status``, ``error``.  Types are
-fixed by the column (:func:`frame` for rows, :func:`typed` for a table read back): parameters as
+fixed by the column (:func:`frame` for rows, :func:`~.table_rows.check_rows` for a table read back): parameters as
 :func:`~mbs_models.studies.grid.column_values` gives them (``kinds``: float, bool or text), metrics
 ``float64``, counts nullable ``Int64``, text ``object`` (None where empty), so that a table read back from
 its file equals the one built in memory.
@@ -11,18 +11,24 @@ its file equals the one built in memory.
 of rows, flushed to the system at once -- a SIGKILL loses nothing written -- and synced to disk at most
 every ``sync_interval`` seconds; a Parquet file cannot be appended to, so its rows go to a CSV journal
 ``FILE.parquet.rows.csv`` beside it), :meth:`SweepFile.chunks` reads the file back ``chunk_rows`` rows at a
-time (a CSV line cut short by a kill is dropped), and :meth:`SweepFile.finish` rewrites it in grid order,
-atomically, through the external sort of :mod:`.table_sort` (a Parquet file then takes the journal's rows
-and the journal goes).  ``FILE.sweep.json`` beside it records what the rows were computed with (the scene,
-end time, accuracy...), and a run with other settings is refused (:meth:`SweepFile.check_settings`) rather
-than mixed in.
+time, every row checked (:mod:`.table_rows`: a CSV line cut short by a kill, a row cut short and ended by
+a newline, a second header line, a cell that is no number where one belongs are dropped and counted in
+:attr:`SweepFile.unreadable`, and their points run again), and :meth:`SweepFile.finish` rewrites it in
+grid order, atomically, through the external sort of :mod:`.table_sort` (a Parquet file then takes the
+journal's rows and the journal goes).  ``FILE.sweep.json`` beside it records what the rows were computed
+with (the scene, end time, accuracy...), and a run with other settings -- or over rows without that
+record -- is refused (:meth:`SweepFile.check_settings`) rather than mixed in.  A file that cannot be
+written (a full disk) raises :class:`SweepWriteError`, every row written before kept; the temporary files
+a killed run leaves beside the table go at the next run (:meth:`SweepFile.clean_temporaries`).
 """
 
 from __future__ import annotations
 
 import json
 import os
+import re
 import time
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, Callable, Iterable, Iterator, Mapping, Sequence
 
@@ -30,8 +36,9 @@ import numpy as np
 import pandas as pd
 
 from ..outputs import atomic_write_with
-from ..errors import SceneError
-from .point import COUNT_COLUMNS, STATUS_COLUMNS, TEXT_COLUMNS
+from ..errors import RecoilError, SceneError
+from .point import STATUS_COLUMNS
+from .table_rows import Unreadable, check_rows, csv_chunks, csv_text, is_count, is_text, read_header
 from .table_sort import SortStats
 
 FORMATS = {".csv": "csv", ".parquet": "parquet"}
@@ -39,16 +46,30 @@ FORMATS = {".csv": "csv", ".parquet": "parquet"}
 CHUNK_ROWS = 20_000
 #: Parameter kinds (:func:`param_kinds`).
 KINDS = ("float", "bool", "text")
-#: read_csv's arguments for floats that round-trip exactly (pandas 3 does by default and deprecates the option).
-_EXACT_FLOATS = {"float_precision": "round_trip"} if int(pd.__version__.split(".")[0]) < 3 else {}
+#: The names of the temporary files written beside a table ``NAME`` (``mkstemp``'s 8 random characters): an
+#: atomic rewrite ``.NAME.XXXXXXXX.tmp``, a sort's runs ``.NAME.sort-XXXXXXXX.tmp``, the settings'
+#: ``.NAME.sweep.json.XXXXXXXX.tmp``.
+_TEMPORARY = r"\.{name}\.(?:sort-|sweep\.json\.)?[a-z0-9_]{{8}}\.tmp"
 
 
-def _is_count(column: str) -> bool:
-    return column in COUNT_COLUMNS or column.rsplit(".", 1)[-1] in COUNT_COLUMNS
+class SweepWriteError(RecoilError):
+    """The table's file (or its journal, or its settings) cannot be written -- the disk is full, the file
+    system gone read-only: ``path`` and the system's ``reason``.  Every row written before is kept, and the
+    same sweep run again resumes from them."""
+
+    def __init__(self, path: str | os.PathLike, reason: str):
+        self.path, self.reason = str(path), reason
+        super().__init__(f"cannot write {self.path}: {reason}; every row written before is kept: make room and "
+                         "run the same sweep again to resume")
 
 
-def _is_text(column: str) -> bool:
-    return column in TEXT_COLUMNS
+@contextmanager
+def writing(path: str | os.PathLike):
+    """An OSError while writing ``path`` raised as a :class:`SweepWriteError`."""
+    try:
+        yield
+    except OSError as exc:
+        raise SweepWriteError(path, exc.strerror or str(exc) or type(exc).__name__) from None
 
 
 def param_kinds(params: Sequence[str], cells: Sequence[Sequence[Any]]) -> dict[str, str]:
@@ -90,9 +111,9 @@ def frame(rows: Iterable[dict], params: Sequence[str], metrics: Sequence[str],
                 data[column] = np.array(values, dtype=bool)
             else:
                 data[column] = pd.Series(values, dtype=object)
-        elif _is_text(column):
+        elif is_text(column):
             data[column] = pd.Series([None if _missing(v) else str(v) for v in values], dtype=object)
-        elif _is_count(column):
+        elif is_count(column):
             data[column] = pd.array([pd.NA if _missing(v) else int(v) for v in values], dtype="Int64")
         else:
             data[column] = np.array([np.nan if _missing(v) else float(v) for v in values], dtype="float64")
@@ -103,42 +124,6 @@ def _missing(value: Any) -> bool:
     if value is None or value is pd.NA:
         return True
     return isinstance(value, float) and value != value
-
-
-def _text(column: pd.Series) -> pd.Series:
-    """A column as ``object`` text: ``str`` values, None where empty."""
-    values = column.to_numpy(dtype=object, na_value=None)
-    return pd.Series([None if _missing(v) else str(v) for v in values], dtype=object, index=column.index)
-
-
-def typed(raw: pd.DataFrame, params: Sequence[str], metrics: Sequence[str],
-          kinds: Mapping[str, str] | None = None) -> pd.DataFrame:
-    """A table read back (from CSV or Parquet) with the types :func:`frame` gives its rows, column by column
-    (vectorised: ``typed(read) == frame(rows)``); ValueError if a column cannot have its type (the file holds
-    another sweep)."""
-    columns = [*params, *metrics, *STATUS_COLUMNS]
-    data = {}
-    for column in columns:
-        values = raw[column].reset_index(drop=True)
-        if column in params:
-            kind = kinds[column] if kinds else _inferred_kind(values)
-            if kind == "float":
-                if not (pd.api.types.is_numeric_dtype(values) and not pd.api.types.is_bool_dtype(values)):
-                    raise ValueError(f"column {column!r} does not hold numbers")
-                data[column] = values.to_numpy(dtype="float64", na_value=np.nan)
-            elif kind == "bool":
-                if not pd.api.types.is_bool_dtype(values):
-                    raise ValueError(f"column {column!r} does not hold true/false")
-                data[column] = values.to_numpy(dtype=bool)
-            else:
-                data[column] = _text(values)
-        elif _is_text(column):
-            data[column] = _text(values)
-        elif _is_count(column):
-            data[column] = pd.array(values.to_numpy(dtype="float64", na_value=np.nan), dtype="Int64")
-        else:
-            data[column] = values.to_numpy(dtype="float64", na_value=np.nan)
-    return pd.DataFrame(data, columns=columns)
 
 
 def _inferred_kind(values: pd.Series) -> str:
@@ -186,6 +171,8 @@ class SweepFile:
         self.columns = [*self.params, *self.metrics, *STATUS_COLUMNS]
         self.chunk_rows, self.sync_interval = chunk_rows, sync_interval
         self._synced = time.monotonic()
+        #: The rows the last reading (:meth:`chunks`) dropped, one :class:`~.table_rows.Unreadable` per file.
+        self.unreadable: list[Unreadable] = []
 
     # ------------------------------------------------------------------ what the rows were computed with
     @property
@@ -210,46 +197,86 @@ class SweepFile:
 
     def check_settings(self, settings: dict[str, Any]) -> None:
         """SceneError if the table's rows were computed with other ``settings`` (the scene, end time,
-        accuracy...) than these; nothing is known of a table without its settings file (it is taken as is)."""
-        if not self.has_rows() or not self.settings_path.exists():
+        accuracy...) than these, or if it has rows but no settings file (what they were computed with is
+        not known: they are not mixed with others), or if that file is not one a sweep writes."""
+        if not self.has_rows():
             return
+        name = self.settings_path.name
+        if not self.settings_path.exists():
+            raise SceneError("out", f"{self.path} holds rows but not {name}, the record of what they were "
+                                    f"computed with (scene, end time, accuracy): restore {name}, or delete "
+                                    f"{self.path.name} to start again")
         try:
             recorded = json.loads(self.settings_path.read_text(encoding="utf-8"))
         except (OSError, ValueError) as exc:
+            reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
             raise SceneError("out", f"cannot read {self.settings_path} (what {self.path} was computed with): "
-                                    f"{exc}; delete both to start again") from None
+                                    f"{reason}; restore it, or delete both to start again") from None
+        if not isinstance(recorded, dict):
+            raise SceneError("out", f"{self.settings_path} (what {self.path} was computed with) holds a JSON "
+                                    f"{type(recorded).__name__}, not the object a sweep writes: restore it, or "
+                                    "delete both to start again")
         differing = [key for key in sorted(set(recorded) | set(settings)) if recorded.get(key) != settings.get(key)]
         if differing:
             raise SceneError("out", f"{self.path} holds a sweep computed with another {', '.join(differing)} "
-                                    f"(see {self.settings_path.name}): choose another file, or delete both to "
-                                    "start again")
+                                    f"(see {name}): choose another file, or delete both to start again")
+
+    def clean_temporaries(self) -> list[Path]:
+        """Remove the temporary files a killed run left beside the table (an atomic rewrite, a sort's runs, the
+        settings being written: :data:`_TEMPORARY`) and return them.  Only while this sweep holds the
+        table's lock (:mod:`.sweep_lock`): no other run can be writing them."""
+        pattern = re.compile(_TEMPORARY.format(name=re.escape(self.path.name)) + r"\Z")
+        removed = []
+        with os.scandir(self.path.parent if str(self.path.parent) else ".") as entries:
+            for entry in entries:
+                if pattern.match(entry.name):
+                    try:
+                        os.unlink(entry.path)
+                        removed.append(Path(entry.path))
+                    except OSError:
+                        pass
+        return removed
 
     def write_settings(self, settings: dict[str, Any]) -> None:
         """Record what the rows are computed with (atomically)."""
         text = json.dumps(settings, indent=2, sort_keys=True) + "\n"
-        self._atomic(lambda path: Path(path).write_text(text, encoding="utf-8"), self.settings_path)
+        with writing(self.settings_path):
+            self._atomic(lambda path: Path(path).write_text(text, encoding="utf-8"), self.settings_path)
 
     # ------------------------------------------------------------------ reading
     def chunks(self) -> Iterator[pd.DataFrame]:
-        """The rows a previous run left (the table, then a Parquet table's journal), typed (:func:`typed`),
-        ``chunk_rows`` at a time; SceneError if the file holds another table (other columns or types) or
-        cannot be read."""
+        """The rows a previous run left (the table, then a Parquet table's journal), checked
+        (:func:`~mbs_models.studies.table_rows.check_rows`: the unreadable ones dropped and counted in
+        :attr:`unreadable`) and typed as :func:`frame` types rows, ``chunk_rows`` at a time; SceneError if the file holds
+        another table (other columns, or parameters of other kinds) or cannot be read."""
         sources = [(self.path, self.format)]
         if self.journal_path is not None:
             sources.append((self.journal_path, "csv"))
+        self.unreadable = []
         for path, fmt in sources:
             if not path.exists() or path.stat().st_size == 0:
                 continue
+            unreadable = Unreadable(path, "line" if fmt == "csv" else "row")
             try:
-                raws = self._csv_chunks(path) if fmt == "csv" else self._parquet_chunks(path)
-                for raw in raws:
-                    if len(raw):   # a file of its header alone (a run killed before its first row) gives nothing
-                        yield typed(raw, self.params, self.metrics, self.kinds)
+                pieces = self._csv_pieces(path) if fmt == "csv" else self._parquet_pieces(path)
+                for raw, numbers, quoted, dropped in pieces:
+                    kinds = self.kinds or {param: _inferred_kind(raw[param]) for param in self.params}
+                    clean, broken, foreign = check_rows(raw, self.params, self.metrics, kinds, quoted)
+                    if foreign is not None:
+                        position, why = foreign
+                        raise SceneError("out", f"{path} holds another sweep's rows ({unreadable.unit} "
+                                                f"{numbers[position]}: {why}): choose another file, remove those "
+                                                "rows, or delete it to start again")
+                    unreadable.add(np.sort(np.concatenate([dropped, numbers[broken]])))
+                    if len(clean):
+                        yield clean
             except (OSError, ValueError, KeyError) as exc:
                 if isinstance(exc, SceneError):
                     raise
                 raise SceneError("out", f"cannot read the existing {path} to resume it: "
                                         f"{str(exc).splitlines()[0] if str(exc) else type(exc).__name__}") from None
+            if unreadable.count:
+                self.unreadable.append(unreadable)
 
     def read(self) -> pd.DataFrame:
         """The whole table (an empty one if there is none): :meth:`chunks` joined (in memory)."""
@@ -263,48 +290,58 @@ class SweepFile:
             raise SceneError("out", f"{path} holds another sweep's table (its columns differ from this sweep's): "
                                     "choose another file, or delete it to start again")
 
-    def _csv_chunks(self, path: Path) -> Iterator[pd.DataFrame]:
+    def _csv_pieces(self, path: Path) -> Iterator[tuple[pd.DataFrame, np.ndarray, np.ndarray, np.ndarray]]:
         drop_cut_line(path)
         if path.stat().st_size == 0:
             return
-        header = pd.read_csv(path, nrows=0)
-        self._check_columns(header.columns, path)
-        text = {c: object for c in self.columns if _is_text(c) or (self.kinds or {}).get(c) == "text"}
-        reader = pd.read_csv(path, keep_default_na=False, na_values=[""], dtype=text, chunksize=self.chunk_rows,
-                             **_EXACT_FLOATS)
-        with reader:
-            yield from reader
+        text = [c for c in self.columns if is_text(c) or (self.kinds or {}).get(c) == "text"]
+        with open(path, "rb") as handle:
+            header = read_header(handle, self.columns)
+            self._check_columns(header or [], path)
+            yield from csv_chunks(handle, self.columns, text, self.chunk_rows)
 
-    def _parquet_chunks(self, path: Path) -> Iterator[pd.DataFrame]:
+    def _parquet_pieces(self, path: Path) -> Iterator[tuple[pd.DataFrame, np.ndarray, None, np.ndarray]]:
         import pyarrow.parquet as pq
 
         source = pq.ParquetFile(path)
         self._check_columns(source.schema_arrow.names, path)
+        first = 1
         for batch in source.iter_batches(batch_size=self.chunk_rows):
-            yield batch.to_pandas()
+            raw = batch.to_pandas()
+            yield raw, np.arange(first, first + len(raw), dtype=np.int64), None, np.zeros(0, dtype=np.int64)
+            first += len(raw)
 
     # ------------------------------------------------------------------ writing
     def append(self, rows: Sequence[dict]) -> None:
         """Append ``rows`` to the CSV table (or a Parquet table's journal), flushed to the system at once (a
-        killed process loses none of them) and synced to disk at most every ``sync_interval`` seconds."""
+        killed process loses none of them) and synced to disk at most every ``sync_interval`` seconds; the
+        ``error`` cell quoted (:func:`~mbs_models.studies.table_rows.csv_text`).  SweepWriteError if it
+        cannot be written (the rows before are kept; a row written in part is dropped when read)."""
         if not rows:
             return
         path = self._appended
-        new = not path.exists() or path.stat().st_size == 0
         table = frame(rows, self.params, self.metrics, self.kinds)
-        with open(path, "a", encoding="utf-8", newline="") as handle:
-            table.to_csv(handle, header=new, index=False)
-            handle.flush()
-            if time.monotonic() - self._synced >= self.sync_interval:
-                os.fsync(handle.fileno())
-                self._synced = time.monotonic()
+        with writing(path):
+            new = not path.exists() or path.stat().st_size == 0
+            text = csv_text(table, header=new)
+            with open(path, "a", encoding="utf-8", newline="") as handle:
+                self._write(handle, text)
+                handle.flush()
+                if time.monotonic() - self._synced >= self.sync_interval:
+                    os.fsync(handle.fileno())
+                    self._synced = time.monotonic()
+
+    @staticmethod
+    def _write(handle, text: str) -> None:
+        handle.write(text)
 
     def sync(self) -> None:
         """Sync the appended rows to disk."""
         path = self._appended
-        if path.exists():
-            with open(path, "a", encoding="utf-8") as handle:
-                os.fsync(handle.fileno())
+        with writing(path):
+            if path.exists():
+                with open(path, "a", encoding="utf-8") as handle:
+                    os.fsync(handle.fileno())
         self._synced = time.monotonic()
 
     def finish(self, index_of: Callable[[pd.DataFrame], np.ndarray],
@@ -327,17 +364,19 @@ class SweepFile:
                 stats.append(sort_chunks(chunks, take, self.path.parent, prefix=f".{self.path.name}.sort-",
                                          **sort_options))
 
-        self._atomic(write)
-        if self.journal_path is not None and self.journal_path.exists():
-            self.journal_path.unlink()
+        with writing(self.path):
+            self._atomic(write)
+            if self.journal_path is not None and self.journal_path.exists():
+                self.journal_path.unlink()
         return stats[0]
 
     def write_all(self, table: pd.DataFrame) -> None:
         """Replace the file by ``table`` (atomically: a temporary file beside it, then renamed)."""
-        if self.format == "csv":
-            self._atomic(lambda path: table.to_csv(path, index=False))
-        else:
-            self._atomic(lambda path: table.to_parquet(path, index=False))
+        with writing(self.path):
+            if self.format == "csv":
+                self._atomic(lambda path: Path(path).write_text(csv_text(table, header=True), encoding="utf-8"))
+            else:
+                self._atomic(lambda path: table.to_parquet(path, index=False))
 
     def _atomic(self, write, target: Path | None = None) -> None:
         """Write ``target`` (default: the table's file) through ``write(temporary_path)`` atomically, with the
@@ -346,7 +385,8 @@ class SweepFile:
 
 
 class _ChunkWriter:
-    """Writes a table chunk by chunk: CSV (the bytes of one ``to_csv`` of the whole table) or Parquet (one row
+    """Writes a table chunk by chunk: CSV (the bytes of one :func:`~mbs_models.studies.table_rows.csv_text` of
+    the whole table) or Parquet (one row
     group per chunk, the types of :func:`parquet_schema`)."""
 
     def __init__(self, path: Path, fmt: str, params, metrics, kinds):
@@ -358,11 +398,10 @@ class _ChunkWriter:
 
     def write(self, chunk: pd.DataFrame) -> None:
         if self.format == "csv":
-            if self._handle is None:
+            first = self._handle is None
+            if first:
                 self._handle = open(self.path, "w", encoding="utf-8", newline="")
-                chunk.to_csv(self._handle, index=False)
-            else:
-                chunk.to_csv(self._handle, header=False, index=False)
+            self._handle.write(csv_text(chunk, header=first))
             return
         import pyarrow as pa
         import pyarrow.parquet as pq
@@ -397,9 +436,9 @@ def parquet_schema(params: Sequence[str], metrics: Sequence[str], kinds: Mapping
         if column in params:
             kind = kinds[column] if kinds else _inferred_kind(sample[column])
             kind_type = {"float": pa.float64(), "bool": pa.bool_(), "text": pa.string()}[kind]
-        elif _is_text(column):
+        elif is_text(column):
             kind_type = pa.string()
-        elif _is_count(column):
+        elif is_count(column):
             kind_type = pa.int64()
         else:
             kind_type = pa.float64()
@@ -430,5 +469,5 @@ def drop_cut_line(path: Path, block: int = 1 << 16) -> None:
         handle.truncate(0)
 
 
-__all__ = ["SweepFile", "frame", "typed", "param_kinds", "check_out", "FORMATS", "CHUNK_ROWS", "parquet_schema",
-           "drop_cut_line"]
+__all__ = ["SweepFile", "SweepWriteError", "writing", "frame", "param_kinds", "check_out", "FORMATS",
+           "CHUNK_ROWS", "parquet_schema", "drop_cut_line"]

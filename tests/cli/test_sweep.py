@@ -329,3 +329,258 @@ def test_a_killed_sweep_resumes_to_exactly_the_uninterrupted_table(tmp_path):
     resumed = pd.read_csv(out, keep_default_na=False, na_values=[""])
     expected_text = pd.read_csv(io.StringIO(expected.to_csv(index=False)), keep_default_na=False, na_values=[""])
     pd.testing.assert_frame_equal(resumed.drop(columns="wall_time"), expected_text.drop(columns="wall_time"))
+
+
+# ================================================================================================ faults
+FAKE = ["--param", "absorber.mass=100,400,1000", "--param", "contact.gap=0:0.1:101"]   # 303 points
+
+
+def _fake_run(argv: list[str], **popen) -> "subprocess.Popen":
+    """``recoil ARGV`` in a new process (its own session: its pool is killed with it) whose points are
+    tests/fake_points.fake_point, after ``prelude`` (Python run first)."""
+    import os
+    import subprocess
+    import sys
+
+    prelude = popen.pop("prelude", "")
+    script = ("import sys\nimport fake_points\nfrom mbs_models.studies import point\n"
+              "point.evaluate_point = fake_points.fake_point\n" + prelude +
+              "from mbs_models.cli import main\nsys.exit(main(sys.argv[1:]))\n")
+    return subprocess.Popen([sys.executable, "-c", script, *argv], start_new_session=True,
+                            env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}, **popen)
+
+
+def _kill(proc) -> None:
+    import os
+    import signal
+
+    try:
+        os.killpg(proc.pid, signal.SIGKILL)
+    except ProcessLookupError:
+        pass
+    proc.wait()
+
+
+def _uninterrupted(monkeypatch, grid=None):
+    import fake_points
+
+    from mbs_models import run_sweep
+
+    fake_points.patch(monkeypatch)
+    grid = grid or {"absorber.mass": "100,400,1000", "contact.gap": "0:0.1:101"}
+    return fake_points.as_read(run_sweep(model_i(), grid, workers=1, progress=False))
+
+
+def _read(out):
+    """The table in ``out`` as plain pandas reads it from CSV, without wall times (fake_points.as_read)."""
+    import fake_points
+
+    if out.suffix == ".csv":
+        return pd.read_csv(out, keep_default_na=False, na_values=[""]).drop(columns="wall_time")
+    return fake_points.as_read(pd.read_parquet(out))
+
+
+def test_a_point_that_raises_anything_is_a_failed_row(tmp_path, capsys, monkeypatch):
+    """The report's case: an extreme value whose solve raises an OverflowError (here made to) is a row, the sweep
+    goes on (on a pool: its worker reports it), and running the command again runs nothing."""
+    from mbs_models.studies import point
+
+    real = point.simulate_scene
+
+    def overflowing(scene, settings):
+        if scene.initial_velocity > 1e3:   # m/s of the barrel: the muzzle velocity of 1e7 m/s
+            raise OverflowError(34, "Numerical result out of range")
+        return real(scene, settings)
+
+    monkeypatch.setattr(point, "simulate_scene", overflowing)
+    out = tmp_path / "t.csv"
+    argv = ["sweep", "model_i", "--param", "firing.muzzle_velocity=564,1e7,600", "--out", str(out), "--end-time",
+            "0.2", "--accuracy", "draft", "--workers", "2"]
+    assert main(argv) == 0
+    printed = capsys.readouterr().out
+    assert "3 points: 3 run, 0 resumed from the file, 1 failed" in printed
+    assert "failed at firing.muzzle_velocity=10000000.0: OverflowError: (34, 'Numerical result out of range')" in printed
+    assert pd.read_csv(out)["status"].tolist() == ["ok", "OverflowError", "ok"]
+    assert main(argv) == 0
+    assert "3 points: 0 run, 3 resumed from the file, 1 failed" in capsys.readouterr().out
+
+
+def test_a_second_sweep_on_the_same_file_is_refused_naming_the_first(tmp_path, capsys, monkeypatch):
+    import subprocess
+
+    out = tmp_path / "s.csv"
+    argv = ["sweep", "model_i", *FAKE, "--out", str(out), "--workers", "1"]
+    first = _fake_run(argv, prelude="fake_points.FAKE_SECONDS = 0.05\n", stdout=subprocess.DEVNULL,
+                      stderr=subprocess.DEVNULL)
+    try:
+        import time
+
+        deadline = time.monotonic() + 60
+        while not (tmp_path / "s.csv.lock").exists() and time.monotonic() < deadline:
+            time.sleep(0.01)
+        time.sleep(0.2)
+        assert main(argv) == 2
+        err = capsys.readouterr().err
+        assert err.startswith(f"recoil: error: --out: {out} is being written by another sweep (process {first.pid} on ")
+        assert err.endswith("): wait for it to end, or give another file\n") and err.count("\n") == 1
+        assert first.poll() is None
+    finally:
+        _kill(first)
+    import fake_points
+
+    fake_points.patch(monkeypatch)
+    assert main([*argv[:-2], "--workers", "2"]) == 0   # killed: its lock is gone with it; this one resumes its rows
+    assert "303 points:" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("settings, needle", [
+    (None, "s.csv holds rows but not s.csv.sweep.json, the record of what they were computed with (scene, end "
+           "time, accuracy): restore s.csv.sweep.json, or delete s.csv to start again"),
+    ("[1, 2]", "s.csv.sweep.json (what"),
+])
+def test_rows_without_sound_settings_exit_2_with_one_line(tmp_path, capsys, settings, needle):
+    out = tmp_path / "s.csv"
+    argv = ["sweep", "model_i", "--param", "contact.gap=0", "--out", str(out), "--workers", "1"]
+    assert main([*argv, "--end-time", "0.2"]) == 0
+    sidecar = tmp_path / "s.csv.sweep.json"
+    sidecar.unlink() if settings is None else sidecar.write_text(settings)
+    capsys.readouterr()
+    assert main([*argv, "--end-time", "0.3"]) == 2   # another end time: mixed in, were the settings unknown
+    err = capsys.readouterr().err
+    assert err.startswith("recoil: error: --out: ") and needle in err and err.count("\n") == 1
+
+
+def test_a_full_disk_is_one_line_and_exit_1(tmp_path, capsys):
+    """A real ENOSPC: the table is /dev/full."""
+    import os
+
+    if not os.path.exists("/dev/full"):
+        pytest.skip("no /dev/full here")
+    out = tmp_path / "s.csv"
+    out.symlink_to("/dev/full")
+    assert main(["sweep", "model_i", "--param", "contact.gap=0,0.01", "--out", str(out), "--end-time", "0.2",
+                 "--workers", "1"]) == 1
+    err = capsys.readouterr().err
+    assert err == (f"recoil: error: cannot write {out}: No space left on device; every row written before is kept: "
+                   "make room and run the same sweep again to resume\n")
+
+
+def test_unreadable_rows_are_one_line_on_stderr(tmp_path, capsys, monkeypatch):
+    import fake_points
+
+    fake_points.patch(monkeypatch)
+    out = tmp_path / "s.csv"
+    argv = ["sweep", "model_i", "--param", "contact.gap=0,0.01,0.02", "--out", str(out), "--workers", "1"]
+    assert main(argv) == 0
+    lines = out.read_bytes().splitlines(keepends=True)
+    out.write_bytes(b"".join(lines[:2]) + lines[0] + lines[2][:20] + b"\n" + lines[3])
+    capsys.readouterr()
+    assert main(argv) == 0
+    captured = capsys.readouterr()
+    assert captured.err.splitlines()[0] == f"{out}: 2 rows unreadable (line 3, 4): their points run again"
+    assert "3 points: 1 run, 2 resumed from the file, 0 failed" in captured.out
+    written = out.read_bytes().splitlines(keepends=True)   # rewritten in grid order, the bad lines gone
+    assert len(written) == 4 and written[:2] == lines[:2] and written[3] == lines[3]
+    pd.testing.assert_frame_equal(_read(out), _uninterrupted(monkeypatch, {"contact.gap": "0,0.01,0.02"}))
+
+
+def test_a_kill_during_the_parquet_rewrite_leaves_nothing_the_next_run_keeps(tmp_path, monkeypatch):
+    """SIGKILL while the finished Parquet table is being written (its temporary file half done): the next run
+    removes the temporary file and ends with the table."""
+    import subprocess
+
+    pytest.importorskip("pyarrow")
+    out = tmp_path / "s.parquet"
+    argv = ["sweep", "model_i", *FAKE, "--out", str(out), "--workers", "1"]
+    slow_rewrite = ("from mbs_models.studies import sweep_table\nimport time\nwrite = sweep_table._ChunkWriter.write\n"
+                    "def slow(self, chunk):\n    write(self, chunk)\n    print('rewriting', flush=True)\n"
+                    "    time.sleep(120)\nsweep_table._ChunkWriter.write = slow\n")
+    proc = _fake_run(argv, prelude=slow_rewrite, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+    try:
+        assert proc.stdout.readline().strip() == "rewriting"
+        left = [p.name for p in tmp_path.iterdir() if p.name.endswith(".tmp")]
+        assert left and all(name.startswith(".s.parquet.") for name in left)
+    finally:
+        _kill(proc)
+    assert not out.exists() and (tmp_path / "s.parquet.rows.csv").exists() and left == [
+        p.name for p in tmp_path.iterdir() if p.name.endswith(".tmp")]
+    expected = _uninterrupted(monkeypatch)
+    assert main(argv) == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.parquet", "s.parquet.sweep.json"]
+    pd.testing.assert_frame_equal(_read(out), expected)
+
+
+def _damage(path, rng) -> str:
+    """One fault a crash can leave in a table being appended to, chosen by ``rng``; what it was."""
+    lines = path.read_bytes().splitlines(keepends=True)
+    rows = [line for line in lines[1:] if line.endswith(b"\n")]
+    if not rows:
+        return "nothing"
+    kind = rng.integers(5)
+    row = rows[rng.integers(len(rows))]
+    if kind == 0:     # the last complete row torn and ended by a newline (its point must run again)
+        body = b"".join(lines[:-1]) if not lines[-1].endswith(b"\n") else b"".join(lines)
+        last = body.splitlines(keepends=True)[-1]
+        if last == lines[0]:
+            return "nothing"
+        path.write_bytes(body[:-len(last)] + last[:rng.integers(1, len(last) - 1)] + b"\n")
+        return "torn last row"
+    extra = {1: row[:rng.integers(1, len(row) - 1)] + b"\n",            # a torn copy of a row
+             2: lines[0],                                                # a second header
+             3: b"\0" * int(rng.integers(1, 200)) + b"\n",              # zeros
+             4: row.replace(b",end_time,", b",end_time,oops", 1)                # steps no number, or
+                   .replace(b",SimulationError,", b",Simulation Error,", 1)}[kind]   # a status no class name
+    with open(path, "ab") as handle:
+        handle.write(extra if lines[-1].endswith(b"\n") else b"\n" + extra)
+    return ["", "torn copy", "header", "zeros", "garbled"][kind]
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".parquet"])
+def test_killed_at_random_moments_with_damaged_rows_resumes_to_the_uninterrupted_table(tmp_path, monkeypatch,
+                                                                                        suffix):
+    """Fault injection: the sweep is SIGKILLed (with its pool) at random moments -- while it writes rows, or
+    folds a Parquet journal in -- and between runs its file gets the damage a crash can leave (a torn row ended by
+    a newline, a second header, zeros, a garbled cell).  Once a run finishes, the table is exactly the one an
+    uninterrupted run writes (wall times aside), with no temporary file, journal or lock left."""
+    import subprocess
+    import time
+
+    import numpy as np
+
+    if suffix == ".parquet":
+        pytest.importorskip("pyarrow")
+    rng = np.random.default_rng(20)
+    out = tmp_path / f"s{suffix}"
+    appended = out if suffix == ".csv" else tmp_path / "s.parquet.rows.csv"
+    argv = ["sweep", "model_i", *FAKE, "--out", str(out), "--workers", "2"]
+    kills, damage = 0, []
+
+    def lines():
+        return appended.read_bytes().count(b"\n") if appended.exists() else 0
+
+    for attempt in range(6):
+        before = lines()
+        proc = _fake_run(argv, prelude="fake_points.FAKE_SECONDS = 0.01\n", stdout=subprocess.DEVNULL,
+                         stderr=subprocess.DEVNULL)   # 1.5 s of points on 2 workers
+        # the moment: once 1 to 60 more rows are written, or (one time in four) after 0 to 1.2 s: in the start-up,
+        # the reading of the file, or the final rewrite
+        grown, seconds = int(rng.integers(1, 61)), float(rng.uniform(0, 1.2)) if rng.integers(4) == 0 else None
+        try:
+            start = time.monotonic()
+            while proc.poll() is None and time.monotonic() < start + 120:
+                if (time.monotonic() - start >= seconds) if seconds is not None else lines() >= before + grown:
+                    break
+                time.sleep(0.002)
+        finally:
+            finished = proc.poll() == 0
+            _kill(proc)
+        if finished:
+            break
+        kills += 1
+        if appended.exists():
+            damage.append(_damage(appended, rng))
+    assert kills >= 3, "the sweep was not killed often enough to test anything"
+    expected = _uninterrupted(monkeypatch)
+    assert main(argv) == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([out.name, out.name + ".sweep.json"]), damage
+    pd.testing.assert_frame_equal(_read(out), expected)

@@ -9,6 +9,7 @@ import time
 import pytest
 
 from mbs_models import ClusterError, SceneError
+from mbs_models.errors import SimulationError
 from mbs_models.studies.backends import (BACKENDS, WORKER_TIMEOUT, DaskBackend, ProcessBackend, SerialBackend,
                                          batch_size, check_scheduler, check_worker_timeout, import_distributed,
                                          in_flight, make_backend)
@@ -304,3 +305,123 @@ def test_a_task_that_kills_its_workers_is_a_cluster_error():
             list(backend.run(os._exit, [1]))
     assert str(info.value).startswith("Dask workers kept dying while running one task (killed, out of memory?), "
                                       f"and the scheduler {cluster.scheduler_address} gave it up: ")
+
+
+# ================================================================================================ worker deaths
+def _poisoned(task):
+    """A task ``(poison, signal, flag, batch)``: each number of ``batch`` doubled; its worker process kills itself
+    with ``signal`` if the batch holds a number of ``poison``, or once the file ``flag`` exists."""
+    import os
+
+    poison, sig, flag, batch = task
+    if any(x in poison for x in batch) or (flag is not None and os.path.exists(flag)):
+        import faulthandler
+
+        faulthandler.disable()   # pytest's, inherited by the worker: no traceback dump on the test's stderr
+        os.kill(os.getpid(), sig)
+    return [2 * x for x in batch]
+
+
+def _tasks(batches, poison, sig=None, flag=None):
+    import signal
+
+    return [(frozenset(poison), sig or signal.SIGKILL, flag, batch) for batch in batches]
+
+
+def _by_number(task):
+    poison, sig, flag, batch = task
+    return [(poison, sig, flag, [x]) for x in batch]
+
+
+def _lost(task, reason):
+    return [("lost", x, reason) for x in task[3]]
+
+
+def _flat(results):
+    out = [item for result in results for item in result]
+    return sorted(x for x in out if not isinstance(x, tuple)), [x for x in out if isinstance(x, tuple)]
+
+
+@pytest.mark.parametrize("sig, named", [("SIGKILL", "died of SIGKILL (the out-of-memory killer? a user?)"),
+                                        ("SIGSEGV", "died of SIGSEGV (a crash in compiled code)")])
+def test_a_task_that_kills_its_worker_is_lost_and_the_others_run(sig, named):
+    """Batches of three numbers; the one holding 13 kills its worker (and the pool with it) every time: 13 is
+    lost with the signal named, its batch mates 12 and 14 and every other batch (in flight then, or not yet
+    taken) come back; the run ends normally and the pool works afterwards."""
+    import signal
+
+    batches = [[i, i + 1, i + 2] for i in range(0, 30, 3)]
+    with ProcessBackend(2) as backend:
+        done, lost = _flat(backend.run(_poisoned, _tasks(batches, {13}, getattr(signal, sig)), split=_by_number,
+                                       lost=_lost))
+        assert done == [2 * x for x in range(30) if x != 13]
+        assert lost == [("lost", 13, f"its worker process {named} each of the 3 times it ran it (in its batch, "
+                                     "again, then alone)")]
+        assert _flat(backend.run(_poisoned, _tasks([[1], [2]], set()))) == ([2, 4], [])
+
+
+def test_a_run_of_poisoned_tasks_is_lost_point_by_point():
+    """Twenty tasks in a row that kill their worker (more than twice DEATHS_IN_A_ROW): a task that ran before
+    runs again, alone, finishes, so the deaths are the tasks' own -- all twenty lost, the others run."""
+    from mbs_models.studies.backends import DEATHS_IN_A_ROW
+
+    poison = set(range(10, 30))
+    assert len(poison) > 2 * DEATHS_IN_A_ROW
+    with ProcessBackend(2) as backend:
+        done, lost = _flat(backend.run(_poisoned, _tasks([[i] for i in range(40)], poison), split=_by_number,
+                                       lost=_lost))
+    assert sorted(x[1] for x in lost) == sorted(poison)
+    assert done == [2 * x for x in range(40) if x not in poison]
+
+
+def test_workers_that_die_whatever_they_run_end_the_run(tmp_path):
+    """Every worker dies (no task ever finishes, or -- after some did -- the last one that finished dies too when
+    run again): no point's fault, so nothing is lost; SimulationError after DEATHS_IN_A_ROW tasks."""
+    from mbs_models.studies.backends import DEATHS_IN_A_ROW
+
+    with ProcessBackend(2) as backend:
+        with pytest.raises(SimulationError, match="no point has run yet: something kills every worker"):
+            list(backend.run(_poisoned, _tasks([[i] for i in range(100)], range(100)), split=_by_number, lost=_lost))
+    flag = tmp_path / "die"
+    seen = []
+    with ProcessBackend(2) as backend:
+        with pytest.raises(SimulationError, match="a point that ran before died too"):
+            for result in backend.run(_poisoned, _tasks([[i] for i in range(100)], set(), flag=str(flag)),
+                                      split=_by_number, lost=_lost):
+                seen += result
+                if len(seen) == 5:
+                    flag.touch()     # from now on every process dies
+    assert not any(isinstance(x, tuple) for x in seen)   # no lost point was handed out
+    assert 5 <= len(seen) < 100 - DEATHS_IN_A_ROW
+
+
+def test_without_lost_a_death_ends_the_run():
+    with ProcessBackend(2) as backend:
+        with pytest.raises(SimulationError, match="a worker process died"):
+            list(backend.run(_poisoned, _tasks([[i] for i in range(10)], {3})))
+
+
+def test_a_task_that_kills_its_dask_workers_is_lost():
+    """On Dask the scheduler retries a task whose worker dies (allowed-failures times, 0 here), then reports
+    KilledWorker: the batch is split, the poisoned number lost, its batch mates and the rest come back."""
+    import os
+    import signal
+
+    dask = pytest.importorskip("dask")
+    distributed = pytest.importorskip("dask.distributed")
+    from mbs_models.studies.backends import DaskBackend
+
+    def poisoned(task):   # a local function: pickled by value for the Dask workers (this module is not theirs)
+        batch = task[3]
+        if 13 in batch:
+            os.kill(os.getpid(), signal.SIGKILL)
+        return [2 * x for x in batch]
+
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+        with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                      dashboard_address=None) as cluster:
+            with DaskBackend(cluster.scheduler_address) as backend:
+                done, lost = _flat(backend.run(poisoned, _tasks([[i, i + 1] for i in range(0, 20, 2)], {13}),
+                                               split=_by_number, lost=_lost))
+    assert done == [2 * x for x in range(20) if x != 13]
+    assert lost == [("lost", 13, "the Dask workers running it died each time the scheduler tried it (KilledWorker)")]

@@ -73,20 +73,35 @@ def test_constraint_moves_the_optimum_to_the_sweeps_constrained_one(sweep):
     assert (~solved["feasible"]).any()  # it did explore the infeasible gaps
 
 
-def test_failed_points_are_infeasible_and_do_not_stop_it(monkeypatch, sweep):
-    length, _ = sweep
+def _fail_above_90_mm(how):
+    """simulate_scene, failing above a gap of 90 mm: raising ``how``, or (``"SIGKILL"``) killing its process."""
+    import os
+    import signal
+
     simulate_scene = point.simulate_scene
 
     def failing(scene, settings):
         if scene.absorbers[0].contact.gap > 0.09:
-            raise SimulationError("made to fail above a gap of 90 mm")
+            if how == "SIGKILL":
+                os.kill(os.getpid(), signal.SIGKILL)
+            raise how("made to fail above a gap of 90 mm")
         return simulate_scene(scene, settings)
+    return failing
 
-    monkeypatch.setattr(point, "simulate_scene", failing)  # workers=1: this process
-    result = optimise(model_i(1000.0, 0.0), BOUNDS, "max_barrel_displacement", seed=1, workers=1)
+
+@pytest.mark.parametrize("how, workers, status", [
+    (SimulationError, 1, "SimulationError"), (OverflowError, 1, "OverflowError"),
+    (ZeroDivisionError, 2, "ZeroDivisionError"), ("SIGKILL", 2, "WorkerDied")],
+    ids=["SimulationError", "OverflowError", "ZeroDivisionError on a pool", "a worker killed"])
+def test_failed_points_are_infeasible_and_do_not_stop_it(monkeypatch, sweep, how, workers, status):
+    """Whatever fails a point -- an error of the solve, any other exception, a worker process that dies on it --
+    makes it infeasible, never an exception of the optimisation."""
+    length, _ = sweep
+    monkeypatch.setattr(point, "simulate_scene", _fail_above_90_mm(how))  # this process, and a forked pool's
+    result = optimise(model_i(1000.0, 0.0), BOUNDS, "max_barrel_displacement", seed=1, workers=workers)
     failed = result.history[result.history["status"] != "ok"]
     assert len(failed) > 0 and (failed["contact.gap"] > 0.09).all()
-    assert (failed["status"] == "SimulationError").all() and (~failed["feasible"]).all()
+    assert (failed["status"] == status).all() and (~failed["feasible"]).all()
     assert np.isinf(failed["violation"]).all() and failed["max_barrel_displacement"].isna().all()
     assert result.feasible and abs(result.parameters["contact.gap"] - GAPS[np.argmin(length)]) <= STEP
     assert result.to_dict()["failed_evaluations"] == len(failed)

@@ -70,15 +70,83 @@ def test_a_batch_keeps_the_indices():
     assert [row["status"] for _, row in out] == ["ok", "SceneError"]
 
 
-def test_other_exceptions_are_bugs_and_propagate(monkeypatch):
+class _BrokenMessage(Exception):
+    def __str__(self):
+        raise RuntimeError("no message either")
+
+
+@pytest.mark.parametrize("exc, status, error", [
+    (OverflowError(34, "Numerical result out of range"), "OverflowError", "(34, 'Numerical result out of range')"),
+    (ZeroDivisionError("float division by zero"), "ZeroDivisionError", "float division by zero"),
+    (RuntimeError('line one\n  "line" two\n'), "RuntimeError", "line one; 'line' two"),  # one line, no double quote
+    (MemoryError(), "MemoryError", "MemoryError"),                                       # no message: the class
+    (RecursionError("maximum recursion depth exceeded"), "RecursionError", "maximum recursion depth exceeded"),
+    (_BrokenMessage(), "_BrokenMessage", "_BrokenMessage"),
+    (type("no name", (ValueError,), {})("a\x00b\tc \udcff"), "Exception", "a b c ?"),  # what a table cannot hold
+], ids=lambda v: type(v).__name__ if isinstance(v, BaseException) else None)
+def test_any_exception_of_a_point_is_its_row(monkeypatch, exc, status, error):
+    """Whatever a point raises -- while its scene is built or solved -- is its row: the sweep goes on."""
     import mbs_models.studies.point as point
 
     def broken(scene, settings):
-        raise ZeroDivisionError("a bug")
+        raise exc
 
     monkeypatch.setattr(point, "simulate_scene", broken)
-    with pytest.raises(ZeroDivisionError):
-        evaluate_point(model_i(), {"contact.gap": 0.0}, SETTINGS)
+    row = evaluate_point(model_i(), {"contact.gap": 0.0}, SETTINGS)
+    assert (row["status"], row["error"]) == (status, error)
+    assert row["contact.gap"] == 0.0 and row["wall_time"] >= 0
+    assert all(row[column] is None for column in metric_columns(model_i()))
+
+
+def test_interrupts_are_not_rows(monkeypatch):
+    import mbs_models.studies.point as point
+
+    for exc in (KeyboardInterrupt, SystemExit):
+        def interrupted(scene, settings, exc=exc):
+            raise exc
+
+        monkeypatch.setattr(point, "simulate_scene", interrupted)
+        with pytest.raises(exc):
+            evaluate_point(model_i(), {"contact.gap": 0.0}, SETTINGS)
+
+
+@pytest.mark.parametrize("column, value, needle", [
+    ("max_barrel_displacement", float("nan"), "max_barrel_displacement: the result's value is nan"),
+    ("peak_support_force", float("inf"), "peak_support_force: the result's value is inf"),
+    ("impacts", 2.5, "impacts: the result's count is 2.5"),
+    ("steps", -1, "steps: the result's count is -1"),
+    ("time_of_peak_contact_force", "soon", "could not convert string to float"),
+])
+def test_a_result_that_is_no_number_is_a_failed_point(monkeypatch, column, value, needle):
+    """A row is made only of finite numbers (and counts, and text where text belongs): a NaN or an infinity from
+    a solve is a failed point, never a value of the table."""
+    import mbs_models.studies.point as point
+
+    real = point.result_row
+    monkeypatch.setattr(point, "result_row", lambda result, scene: {**real(result, scene), column: value})
+    row = evaluate_point(model_i(), {"contact.gap": 0.0}, SETTINGS)
+    assert row["status"] in ("SimulationError", "ValueError") and needle in row["error"]
+    assert row["max_barrel_displacement"] is None
+
+
+def test_a_long_message_is_cut():
+    from mbs_models.studies.point import MAX_ERROR_LENGTH, error_text
+
+    text = error_text(ValueError("x" * 5000))
+    assert len(text) == MAX_ERROR_LENGTH and text.endswith("...")
+
+
+def test_a_batch_split_and_lost():
+    """The parts a backend retries when a worker dies, and the rows of a point that killed its worker each time."""
+    from mbs_models.studies.point import WORKER_DIED, lost_batch, split_batch
+
+    task = (model_i(), SETTINGS, [(7, {"contact.gap": 0.0}), (3, {"contact.gap": 0.01})])
+    assert split_batch(task) == [(task[0], SETTINGS, [(7, {"contact.gap": 0.0})]),
+                                 (task[0], SETTINGS, [(3, {"contact.gap": 0.01})])]
+    (index, row), = lost_batch(split_batch(task)[1], "its worker process died of SIGSEGV")
+    assert index == 3 and row["status"] == WORKER_DIED == "WorkerDied"
+    assert row["error"] == "its worker process died of SIGSEGV" and row["contact.gap"] == 0.01
+    assert all(row[column] is None for column in metric_columns(model_i()))
 
 
 def test_conventions_reach_the_row():

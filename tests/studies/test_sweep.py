@@ -509,9 +509,9 @@ def test_table_false_returns_the_summary_and_lists_the_first_failures(tmp_path, 
 def test_a_file_in_any_order_is_resumed_and_ends_in_grid_order(tmp_path, suffix):
     """A file whose rows are in finish order (shuffled here), with points missing, resumes and ends in grid order;
     the kept rows are those of the file (their wall times)."""
-    full = run_sweep(model_i(), FIG_GRID, end_time=0.5, workers=1, progress=False)
-    kept = full.drop(index=[1, 4]).sample(frac=1.0, random_state=3)
     path = tmp_path / f"s{suffix}"
+    full = run_sweep(model_i(), FIG_GRID, end_time=0.5, workers=1, progress=False, out=path)  # and its settings
+    kept = full.drop(index=[1, 4]).sample(frac=1.0, random_state=3)
     if suffix == ".csv":
         kept.to_csv(path, index=False)
     else:
@@ -548,3 +548,228 @@ def test_a_parquet_table_journals_its_rows_until_the_end(tmp_path, monkeypatch):
     pd.testing.assert_frame_equal(_values(resumed), _values(uninterrupted))
     pd.testing.assert_frame_equal(_values(pd.read_parquet(path).astype(object).where(lambda t: t.notna(), None)),
                                   _values(uninterrupted.astype(object).where(uninterrupted.notna(), None)))
+
+
+# ================================================================================================ faults
+def _failing_at(scene, settings, real=point_module.simulate_scene):
+    """simulate_scene, but at gap 10 mm an OverflowError (an extreme value), 20 mm a MemoryError, 30 mm a
+    RecursionError; at 40 mm a result whose max barrel displacement is NaN."""
+    gap = scene.absorbers[0].contact.gap
+    errors = {0.01: OverflowError(34, "Numerical result out of range"), 0.02: MemoryError(),
+              0.03: RecursionError("maximum recursion depth exceeded")}
+    if gap in errors:
+        raise errors[gap]
+    result = real(scene, settings)
+    if gap == 0.04:
+        object.__setattr__(result, "max_barrel_displacement", float("nan")) if hasattr(result, "__dataclass_fields__") \
+            else setattr(result, "max_barrel_displacement", float("nan"))
+    return result
+
+
+FAULT_GAPS = {"contact.gap": [0.0, 0.01, 0.02, 0.03, 0.04, 0.05]}
+FAULT_STATUS = ["ok", "OverflowError", "MemoryError", "RecursionError", "SimulationError", "ok"]
+
+
+def _check_fault_table(table):
+    assert table["status"].tolist() == FAULT_STATUS
+    assert table["error"][1] == "(34, 'Numerical result out of range')" and table["error"][2] == "MemoryError"
+    assert table["error"][4] == "max_barrel_displacement: the result's value is nan, not a finite number"
+    assert table.loc[1:4, "max_barrel_displacement"].isna().all() and table.loc[1:4, "steps"].isna().all()
+    for i in (0, 5):
+        expected = simulate(model_i(1000.0, FAULT_GAPS["contact.gap"][i]), 0.2, "draft")
+        assert table["max_barrel_displacement"][i] == expected.max_barrel_displacement
+    assert table.attrs["sweep"]["failed"] == 4
+
+
+@pytest.mark.parametrize("workers", [1, 2], ids=["serial", "processes"])
+def test_any_exception_of_a_point_is_its_row_and_the_sweep_goes_on(tmp_path, monkeypatch, workers):
+    """Whatever a point raises -- not only SceneError and SimulationError -- is its row (status the class,
+    error one line), a NaN metric a SimulationError; the others run; the file resumes without running any again."""
+    monkeypatch.setattr(point_module, "simulate_scene", _failing_at)   # before the pool forks: its workers too
+    path = tmp_path / "f.csv"
+    table = run_sweep(model_i(), FAULT_GAPS, end_time=0.2, accuracy="draft", workers=workers, batch_size=2,
+                      progress=False, out=path)
+    _check_fault_table(table)
+    again = run_sweep(model_i(), FAULT_GAPS, end_time=0.2, accuracy="draft", workers=workers, progress=False,
+                      out=path)
+    assert again.attrs["sweep"]["run"] == 0 and again["status"].tolist() == FAULT_STATUS
+
+
+def test_any_exception_of_a_point_is_its_row_on_dask(dask_cluster):
+    from dask.distributed import Client
+
+    def patch_workers():   # run on each worker (pickled by value)
+        from mbs_models.studies import point
+
+        point._real_simulate_scene = getattr(point, "_real_simulate_scene", point.simulate_scene)
+
+        def failing(scene, settings):
+            gap = scene.absorbers[0].contact.gap
+            errors = {0.01: OverflowError(34, "Numerical result out of range"), 0.02: MemoryError(),
+                      0.03: RecursionError("maximum recursion depth exceeded")}
+            if gap in errors:
+                raise errors[gap]
+            result = point._real_simulate_scene(scene, settings)
+            if gap == 0.04:
+                object.__setattr__(result, "max_barrel_displacement", float("nan"))
+            return result
+        point.simulate_scene = failing
+
+    def restore_workers():
+        from mbs_models.studies import point
+
+        point.simulate_scene = getattr(point, "_real_simulate_scene", point.simulate_scene)
+
+    with Client(dask_cluster, set_as_default=False) as client:
+        client.run(patch_workers)
+        try:
+            table = run_sweep(model_i(), FAULT_GAPS, end_time=0.2, accuracy="draft", scheduler=client, batch_size=2,
+                              progress=False)
+        finally:
+            client.run(restore_workers)
+    _check_fault_table(table)
+
+
+def _killed_at_gap(scene, settings, real=point_module.simulate_scene):
+    if scene.absorbers[0].contact.gap == 0.02:
+        os.kill(os.getpid(), signal.SIGKILL)   # as the out-of-memory killer, or a crash in compiled code
+    return real(scene, settings)
+
+
+def test_a_point_that_kills_its_worker_is_a_row_and_the_sweep_goes_on(tmp_path, monkeypatch):
+    monkeypatch.setattr(point_module, "simulate_scene", _killed_at_gap)
+    grid = {"contact.gap": [0.0, 0.01, 0.02, 0.03, 0.04, 0.05]}
+    path = tmp_path / "k.csv"
+    table = run_sweep(model_i(), grid, end_time=0.2, accuracy="draft", workers=2, batch_size=3, progress=False,
+                      out=path)
+    assert table["status"].tolist() == ["ok", "ok", "WorkerDied", "ok", "ok", "ok"]
+    assert table["error"][2].startswith("its worker process died of SIGKILL")
+    for i, gap in enumerate(grid["contact.gap"]):
+        if i != 2:
+            assert table["max_barrel_displacement"][i] == simulate(model_i(1000.0, gap), 0.2, "draft").max_barrel_displacement
+    assert run_sweep(model_i(), grid, end_time=0.2, accuracy="draft", workers=2, progress=False,
+                     out=path).attrs["sweep"]["run"] == 0
+
+
+def _lines(path) -> list[bytes]:
+    return path.read_bytes().splitlines(keepends=True)
+
+
+def test_unreadable_rows_are_dropped_named_and_run_again(tmp_path, monkeypatch):
+    """A torn row ended by a newline, a second header and a cell that is no number: one line names them, their
+    points run again, and the file ends as the uninterrupted one (the bad lines gone)."""
+    import fake_points
+
+    fake_points.patch(monkeypatch)
+    grid = {"absorber.mass": [100.0, 1000.0], "contact.gap": [0.0, 0.005, 0.01, 0.02]}
+    path = tmp_path / "s.csv"
+    full = run_sweep(model_i(), grid, workers=1, progress=False, out=path)
+    lines = _lines(path)
+    assert len(lines) == 9 and lines[2].endswith(b',SimulationError,"made to fail at gap 0.005, mass 100.0"\n')
+    torn = lines[8][:lines[8].index(b",end_time,") + 4] + b"\n"          # steps cut short, no status: the last row
+    garbled = lines[4].replace(b"100.0,0.02,", b"100.0,0.02,n/a")                 # a metric that is no number
+    path.write_bytes(b"".join(lines[:3] + [lines[0]] + lines[3:5] + [garbled] + lines[5:8] + [torn]))
+    said = []
+    resumed = run_sweep(model_i(), grid, workers=1, progress=False, out=path, announce=said.append)
+    assert said[0] == f"{path}: 3 rows unreadable (line 4, 7, 11): their points run again"
+    assert resumed.attrs["sweep"]["resumed"] == 7 and resumed.attrs["sweep"]["run"] == 1
+    assert resumed.attrs["sweep"]["unreadable"] == 3
+    pd.testing.assert_frame_equal(_values(resumed), _values(full))
+    assert [line for line in _lines(path) if line != lines[8]] == lines[:8]   # only the torn point's row rewritten
+    with pytest.warns(UserWarning, match="1 row unreadable"):     # no announcement: a warning
+        path.write_bytes(path.read_bytes() + torn)
+        run_sweep(model_i(), grid, workers=1, progress=False, out=path)
+
+
+def test_rows_without_their_settings_are_refused(tmp_path):
+    """Without FILE.sweep.json the settings of the rows are unknown: a run (with other settings, here) is refused,
+    saying how to go on, and nothing is changed."""
+    path = tmp_path / "s.csv"
+    run_sweep(model_i(), {"contact.gap": [0.0]}, end_time=0.2, workers=1, progress=False, out=path)
+    (tmp_path / "s.csv.sweep.json").unlink()
+    before = path.read_bytes()
+    with pytest.raises(SceneError) as info:
+        run_sweep(model_i(), {"contact.gap": [0.0, 0.01]}, end_time=0.3, workers=1, progress=False, out=path)
+    assert info.value.key == "out" and info.value.message == (
+        f"{path} holds rows but not s.csv.sweep.json, the record of what they were computed with (scene, end time, "
+        "accuracy): restore s.csv.sweep.json, or delete s.csv to start again")
+    assert path.read_bytes() == before and not (tmp_path / "s.csv.sweep.json").exists()
+
+
+@pytest.mark.parametrize("text, needle", [("[]", "holds a JSON list, not the object a sweep writes"),
+                                          ('"scene"', "holds a JSON str, not the object"),
+                                          ("null", "holds a JSON NoneType"),
+                                          ('{"end_time": 0.2', "cannot read"),
+                                          (b"\xff\xfe", "cannot read")])
+def test_a_malformed_settings_file_is_one_line(tmp_path, text, needle):
+    path = tmp_path / "s.csv"
+    run_sweep(model_i(), {"contact.gap": [0.0]}, end_time=0.2, workers=1, progress=False, out=path)
+    settings = tmp_path / "s.csv.sweep.json"
+    settings.write_bytes(text if isinstance(text, bytes) else text.encode())
+    with pytest.raises(SceneError) as info:
+        run_sweep(model_i(), {"contact.gap": [0.0]}, end_time=0.2, workers=1, progress=False, out=path)
+    assert info.value.key == "out" and needle in info.value.message and "\n" not in str(info.value)
+
+
+def _full_after(batches: int, monkeypatch):
+    """SweepFile writes fill the disk at the ``batches + 1``-th batch: half its text written, then ENOSPC."""
+    import errno
+
+    from mbs_models.studies.sweep_table import SweepFile
+
+    calls = []
+    real = SweepFile._write
+
+    def write(handle, text):
+        calls.append(text)
+        if len(calls) > batches:
+            real(handle, text[:len(text) // 2])
+            raise OSError(errno.ENOSPC, "No space left on device")
+        real(handle, text)
+
+    monkeypatch.setattr(SweepFile, "_write", staticmethod(write))
+    return calls
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".parquet"])
+def test_a_full_disk_stops_the_sweep_keeping_every_row_written(tmp_path, monkeypatch, suffix):
+    import fake_points
+
+    from mbs_models.studies.sweep_table import SweepWriteError
+
+    fake_points.patch(monkeypatch)
+    grid = {"absorber.mass": [100.0, 1000.0], "contact.gap": "0:0.1:10"}
+    uninterrupted = run_sweep(model_i(), grid, workers=1, progress=False)
+    path = tmp_path / f"s{suffix}"
+    writes = _full_after(3, monkeypatch)   # the 2 probes' rows and a batch of 4; then half a batch
+    with pytest.raises(SweepWriteError) as info:
+        run_sweep(model_i(), grid, workers=1, batch_size=4, progress=False, out=path)
+    half = writes[3][:len(writes[3]) // 2]
+    assert len(writes) == 4 and 1 <= half.count("\n") < 4 and not half.endswith("\n")   # rows, and one cut short
+    written = path.with_name(path.name + ".rows.csv") if suffix == ".parquet" else path
+    assert str(info.value) == (f"cannot write {written}: No space left on device; every row written before is kept: "
+                               "make room and run the same sweep again to resume")
+    monkeypatch.undo()
+    fake_points.patch(monkeypatch)
+    resumed = run_sweep(model_i(), grid, workers=1, progress=False, out=path)
+    assert resumed.attrs["sweep"]["resumed"] == 2 + 4 + half.count("\n")   # every complete row written
+    pd.testing.assert_frame_equal(_values(resumed), _values(uninterrupted))
+
+
+def test_temporary_files_a_killed_run_left_are_removed(tmp_path):
+    path = tmp_path / "s.csv"
+    left = [".s.csv.ab12cd_9.tmp", ".s.csv.sort-x1y2z3w4.tmp", ".s.csv.sweep.json.qwertyui.tmp"]
+    kept = ["s.csv.notes.tmp", ".s.csv.tmp", ".s.csv.x.csv.abcdefgh.tmp", ".other.csv.abcdefgh.tmp"]
+    for name in left + kept:
+        (tmp_path / name).write_text("x")
+    run_sweep(model_i(), {"contact.gap": [0.0]}, end_time=0.2, workers=1, progress=False, out=path)
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(kept + ["s.csv", "s.csv.sweep.json"])
+
+
+def test_a_last_point_that_kills_its_worker_runs_in_a_worker_too(tmp_path, monkeypatch):
+    """One point left (a resumed sweep's last, here the only one): with workers=2 it still runs in a worker
+    process -- a pool of one -- so that its crash is a row, not the end of the sweep for good."""
+    monkeypatch.setattr(point_module, "simulate_scene", _killed_at_gap)
+    table = run_sweep(model_i(), {"contact.gap": [0.02]}, end_time=0.2, accuracy="draft", workers=2, progress=False,
+                      out=tmp_path / "one.csv")
+    assert table["status"].tolist() == ["WorkerDied"]

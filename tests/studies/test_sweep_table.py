@@ -163,7 +163,8 @@ def test_kinds_fix_the_parameter_types(tmp_path):
     SweepFile(tmp_path / "t.csv", PARAMS, METRICS, kinds=kinds).append(rows)
     read = SweepFile(tmp_path / "t.csv", PARAMS, METRICS, kinds=kinds).read()
     assert read["contact.law"].tolist() == ["0.0003"]
-    with pytest.raises(SceneError, match="cannot read"):
+    with pytest.raises(SceneError, match=r"another sweep's rows \(line 2: column 'contact.law' does not hold "
+                                         r"true/false\)"):   # a sound row: another sweep's, not a damaged one
         SweepFile(tmp_path / "t.csv", PARAMS, METRICS, kinds={"contact.gap": "float", "contact.law": "bool"}).read()
 
 
