@@ -10,9 +10,26 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 from .connector import Body
-from .table import Rule, Table
+from .table import Rule, Table, check_derived
 
 BARREL = "barrel"
+
+
+def free_recoil_speed(scene, velocity: float | None = None) -> float:
+    """``shots |v0|`` (m/s): the speed the shots of the scene give the barrel free of any force, its recoil velocity
+    ``v0 = I / M`` (``velocity`` if given; a pulse's ``impulse / M``) once per shot of a ``[burst]``."""
+    if velocity is None:
+        firing = getattr(scene, "firing", None)
+        velocity = scene.initial_velocity if firing is None or firing.pulse is None else \
+            firing.shot_momentum / scene.barrel.mass
+    burst = getattr(scene, "burst", None)
+    return abs(velocity) * (burst.shots if burst is not None else 1)
+
+
+def free_recoil_energy(scene) -> float:
+    """``M (shots v0)^2 / 2`` (J): the kinetic energy of the barrel at its :func:`free_recoil_speed`."""
+    speed = free_recoil_speed(scene)
+    return 0.5 * scene.barrel.mass * speed * speed
 
 
 @dataclass(frozen=True)
@@ -30,6 +47,24 @@ class Barrel(Table):
     TABLE: ClassVar[str] = "barrel"
     ORDER: ClassVar[int] = 0
     RULES: ClassVar = {"mass": Rule(0.0, strict=True, unit="kg"), "initial_velocity": Rule(unit="m/s")}
+
+    def check_in_scene(self, scene, key: str) -> None:
+        """The shot's recoil velocity ``v = I / M`` (or ``initial_velocity``; the pulse's impulse / M) must be
+        finite (and not 0 when a firing momentum gives it), and the largest kinetic energy the shots give the
+        barrel, ``M (shots v)^2 / 2``, and ``(shots v)^2`` finite: a magnitude beyond double precision is bad
+        input (DESIGN.md, "Representable magnitudes")."""
+        firing = scene.firing
+        keys = {f"{key}.mass": self.mass}
+        if firing is None:
+            keys[f"{key}.initial_velocity"] = self.initial_velocity
+            velocity = scene.initial_velocity
+        else:
+            keys.update(firing.shot_keys())
+            velocity = scene.initial_velocity if firing.pulse is None else firing.shot_momentum / self.mass
+            check_derived(keys, "the recoil velocity v0 = I / M", abs(velocity), "m/s", positive=True)
+        speed = free_recoil_speed(scene, velocity)
+        check_derived(keys, "the square of the barrel's largest free-recoil speed (shots v0)^2", speed * speed, "m^2/s^2")
+        check_derived(keys, "the barrel's largest kinetic energy M (shots v0)^2 / 2", 0.5 * self.mass * speed * speed, "J")
 
     def bodies(self, scene, name: str) -> list[Body]:
         """The barrel body, at the scene's initial velocity."""

@@ -34,10 +34,10 @@ from dataclasses import dataclass
 from typing import Any, ClassVar
 
 from ..errors import SceneError
-from .barrel import BARREL
+from .barrel import BARREL, free_recoil_speed
 from .connector import GROUND, Connector
 from .ops import NUMPY_OPS, PYTHON_OPS, Ops, piecewise_linear
-from .table import Rule, Table, check_number
+from .table import Rule, Table, check_derived, check_number
 
 #: The two fields that take a number or a table of (stroke, area) pairs.
 AREA_FIELDS = ("orifice_area", "counter_recoil_orifice_area")
@@ -134,11 +134,45 @@ class RecoilBrake(Table):
             value = getattr(self, name)
             if value is not None or name == "orifice_area":
                 object.__setattr__(self, name, check_area(f"{self.TABLE}.{name}", value))
+        self._check_representable()
+
+    def _check_representable(self) -> None:
+        """Every factor of the law ``K(a) = rho A^3 / (2 Cd^2 a^2)`` finite and > 0 as the law computes it, for
+        the smallest and the largest area: a brake double precision cannot represent is bad input."""
+        A, cd = self.piston_area, self.discharge_coefficient
+        keys = {f"{self.TABLE}.piston_area": A, f"{self.TABLE}.discharge_coefficient": cd,
+                f"{self.TABLE}.fluid_density": self.fluid_density}
+        check_derived(keys, "the cube of the piston area A^3", A * A * A, "m^6", positive=True)
+        check_derived(keys, "the square of the discharge coefficient Cd^2", cd * cd, positive=True)
+        coefficient = check_derived(keys, "the coefficient rho A^3 / (2 Cd^2)", self.coefficient, "kg m", positive=True)
+        for name in AREA_FIELDS:
+            area = getattr(self, name)
+            if area is None:
+                continue
+            areas = [a for _, a in area_points(area)]
+            smallest = {**keys, f"{self.TABLE}.{name}": min(areas)}
+            check_derived(smallest, "the square of the smallest orifice area a^2", min(areas) * min(areas), "m^4",
+                          positive=True)
+            check_derived(smallest, "the brake's coefficient rho A^3 / (2 Cd^2 a^2) at the smallest area",
+                          coefficient / (min(areas) * min(areas)), "kg/m^3")
+            check_derived({**keys, f"{self.TABLE}.{name}": max(areas)},
+                          "the brake's coefficient rho A^3 / (2 Cd^2 a^2) at the largest area",
+                          coefficient / (max(areas) * max(areas)), "kg/m^3", positive=True)
+
+    def check_in_scene(self, scene, key: str) -> None:
+        """The brake's largest force at the barrel's free-recoil speed, ``K(a_min) (shots v0)^2``, must be finite."""
+        area = self.smallest_area()
+        keys = {f"{key}.piston_area": self.piston_area, f"{key}.discharge_coefficient": self.discharge_coefficient,
+                f"{key}.fluid_density": self.fluid_density, f"{key}.orifice_area": area, "barrel.mass": scene.barrel.mass}
+        speed = free_recoil_speed(scene)
+        check_derived(keys, "the brake's force at the barrel's free-recoil speed v, rho A^3 v^2 / (2 Cd^2 a_min^2)",
+                      self.coefficient / (area * area) * speed * speed, "N")
 
     @property
     def coefficient(self) -> float:
         """``rho A^3 / (2 Cd^2)`` in kg m (times ``v|v| / a^2`` it is the force)."""
-        return self.fluid_density * self.piston_area ** 3 / (2.0 * self.discharge_coefficient ** 2)
+        A, cd = self.piston_area, self.discharge_coefficient
+        return self.fluid_density * (A * A * A) / (2.0 * (cd * cd))
 
     def smallest_area(self, d_bound: float = math.inf) -> float:
         """The smallest area (m^2) either branch has at strokes ``|x| <= d_bound`` (m)."""
@@ -193,7 +227,8 @@ class RecoilBrakeConnector(Connector):
         """``rho A^3 |v|max^2 / (2 Cd^2 a_min^2)`` (N), a_min over the strokes ``|x| <= d_bound``."""
         if rate_bound == 0.0:
             return 0.0
-        return self.brake.coefficient * rate_bound ** 2 / self.brake.smallest_area(d_bound) ** 2
+        area = self.brake.smallest_area(d_bound)
+        return self.brake.coefficient * (rate_bound * rate_bound) / (area * area)
 
     def largest_speed(self) -> float:
         """``sqrt(2 E0 / M)`` (m/s): the barrel's speed can never exceed what the initial energy E0 (J: kinetic
@@ -217,7 +252,8 @@ class RecoilBrakeConnector(Connector):
     def linear_damping(self) -> float:
         """The tangent damping ``dF/dv = 2 K |v|`` (N s/m) at its largest during the run: the smallest area
         and the largest speed (:meth:`largest_speed`), the stiffest linearisation a fixed step must survive."""
-        return 2.0 * self.brake.coefficient / self.brake.smallest_area() ** 2 * self.largest_speed()
+        area = self.brake.smallest_area()
+        return 2.0 * self.brake.coefficient / (area * area) * self.largest_speed()
 
     @property
     def first_step_limit(self) -> float:

@@ -281,7 +281,8 @@ class Scene:
     @property
     def initial_kinetic_energy(self) -> float:
         """Kinetic energy at t = 0 in J (the barrel alone moves)."""
-        return 0.5 * self.barrel.mass * self.initial_velocity ** 2
+        velocity = self.initial_velocity
+        return 0.5 * self.barrel.mass * velocity * velocity
 
     # ------------------------------------------------------------------ changes
     def with_changes(self, **changes) -> "Scene":

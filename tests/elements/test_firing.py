@@ -153,7 +153,7 @@ def test_a_bad_pulse_file_is_one_line(tmp_path, capsys, content, text):
     assert len(err) == 1 and "firing.pulse.file" in err[0] and text in err[0]
     (tmp_path / "breech.csv").unlink()
     assert main(["run", str(tmp_path / "scene.toml")]) == 2
-    assert "cannot read the pulse file" in capsys.readouterr().err
+    assert "pulse file not found" in capsys.readouterr().err
 
 
 def test_scenes_round_trip_through_toml(tmp_path):

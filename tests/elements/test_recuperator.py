@@ -212,7 +212,7 @@ def test_a_preload_that_cannot_return_the_barrel_against_gravity_and_friction_is
     resisting = 5600.0 * G * (math.sin(math.radians(30.0)) + 0.1 * math.cos(math.radians(30.0)))  # 32 222 N
     cradle = SimpleNamespace(elevation=30.0, gravity=G, friction_coefficient=0.1)
     scene = SimpleNamespace(barrel=Barrel(5600.0, initial_velocity=0.0), battery_stop=EXAMPLE.battery_stop,
-                            recoil_stop=None, cradle=cradle)
+                            recoil_stop=None, cradle=cradle, initial_velocity=0.0)
     with pytest.raises(SceneError) as info:
         GAS.check_in_scene(scene, "recuperator")
     assert info.value.key == "recuperator.initial_pressure"
