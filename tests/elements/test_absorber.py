@@ -144,7 +144,7 @@ BAD_ABSORBERS = [
     ("contact-not-a-table", "absorber.1.contact", 3.0, "absorber.1.contact", "must be a table"),
     ("missing-gap", "absorber.0.contact.gap", "<delete>", "absorber.0.contact.gap", "missing"),
     ("negative-gap", "absorber.0.contact.gap", -0.01, "absorber.0.contact.gap", ">= 0 m"),
-    ("duplicate-names", "absorber.1.name", "front", "absorber.name", "names two absorbers"),
+    ("duplicate-names", "absorber.1.name", "front", "absorber.1.name", "names two absorbers"),
     ("bad-name", "absorber.1.name", "rear wheel", "absorber.1.name", "identifier"),
     ("unknown-key", "absorber.0.masss", 1.0, "absorber.0.masss", "did you mean 'mass'"),
 ]
