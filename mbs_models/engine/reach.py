@@ -93,13 +93,14 @@ def _free_recoil_reach(mechanism: Mechanism, bounds: EnergyBounds) -> list[float
     K = np.zeros((n, n))
     energy = np.zeros(n)  # per group root
     for i, body in enumerate(mechanism.bodies):
-        energy[root(i)] += 0.5 * body.mass * v0[i] ** 2
+        energy[root(i)] += 0.5 * body.mass * v0[i] * v0[i]
     for c in springs:
         if c.stores_energy:
             g = mechanism.direction(c)
             K += c.linear_stiffness * np.outer(g, g)
             body = c.b if c.b != GROUND else c.a
-            energy[root(index[body])] += 0.5 * c.linear_stiffness * mechanism.relative_at(c, x0) ** 2
+            d0 = mechanism.relative_at(c, x0)
+            energy[root(index[body])] += 0.5 * c.linear_stiffness * d0 * d0
     roots = sorted({root(i) for i in range(n)})
     members = {r: [i for i in range(n) if root(i) == r] for r in roots}
     out = []
@@ -121,7 +122,8 @@ def _free_recoil_reach(mechanism: Mechanism, bounds: EnergyBounds) -> list[float
             if np.any(np.abs(components[~keep]) > 1e-9 * float(np.max(np.abs(g_c)))):
                 reach = math.inf  # a direction without a spring: no bound
                 break
-            coefficient = 2.0 * float(np.sum(components[keep] ** 2 / values[keep]))
+            with np.errstate(over="ignore"):  # a spring too weak for double precision: no bound (inf)
+                coefficient = 2.0 * float(np.sum(components[keep] ** 2 / values[keep]))
             reach += math.sqrt(coefficient * energy[r] * (1.0 + ENERGY_SLACK))
         out.append(reach)
     return out
