@@ -36,12 +36,13 @@ _TOKEN = re.compile(r'''\#[^\n]*
                       | [\[\]{}]''', re.VERBOSE | re.DOTALL)
 
 
-def read_text_file(path: str | Path, key: str, what: str, max_bytes: int = MAX_INPUT_BYTES) -> str:
-    """The UTF-8 text of the regular file ``path`` (at most ``max_bytes``).  SceneError naming ``key`` (``what``
-    describes the file: ``"scene file"``) for a file that does not exist, cannot be opened, is a directory,
-    a device, a pipe or a socket, is larger than ``max_bytes``, holds a NUL byte (a binary file) or is not
-    UTF-8."""
+def read_text_file(path: str | Path, key: str, what: str, max_bytes: int | None = None) -> str:
+    """The UTF-8 text of the regular file ``path`` (at most ``max_bytes``, default :data:`MAX_INPUT_BYTES`).
+    SceneError naming ``key`` (``what`` describes the file: ``"scene file"``) for a file that does not exist,
+    cannot be opened, is a directory, a device, a pipe or a socket, is larger than ``max_bytes``, holds a NUL
+    byte (a binary file) or is not UTF-8."""
     path = Path(path)
+    max_bytes = MAX_INPUT_BYTES if max_bytes is None else max_bytes
     flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_BINARY", 0)
     try:
         descriptor = os.open(path, flags)

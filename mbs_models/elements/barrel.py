@@ -26,6 +26,18 @@ def free_recoil_speed(scene, velocity: float | None = None) -> float:
     return abs(velocity) * (burst.shots if burst is not None else 1)
 
 
+def shot_keys(scene) -> dict[str, float]:
+    """The keys the barrel's recoil velocity v0 depends on, with their values (for errors naming them):
+    ``barrel.mass`` and ``barrel.initial_velocity``, or the firing's (:meth:`Firing.shot_keys`)."""
+    keys = {"barrel.mass": scene.barrel.mass}
+    firing = getattr(scene, "firing", None)
+    if firing is None:
+        keys["barrel.initial_velocity"] = scene.barrel.initial_velocity
+    else:
+        keys.update(firing.shot_keys())
+    return keys
+
+
 def free_recoil_energy(scene) -> float:
     """``M (shots v0)^2 / 2`` (J): the kinetic energy of the barrel at its :func:`free_recoil_speed`."""
     speed = free_recoil_speed(scene)
@@ -54,12 +66,10 @@ class Barrel(Table):
         barrel, ``M (shots v)^2 / 2``, and ``(shots v)^2`` finite: a magnitude beyond double precision is bad
         input (DESIGN.md, "Representable magnitudes")."""
         firing = scene.firing
-        keys = {f"{key}.mass": self.mass}
+        keys = shot_keys(scene)
         if firing is None:
-            keys[f"{key}.initial_velocity"] = self.initial_velocity
             velocity = scene.initial_velocity
         else:
-            keys.update(firing.shot_keys())
             velocity = scene.initial_velocity if firing.pulse is None else firing.shot_momentum / self.mass
             check_derived(keys, "the recoil velocity v0 = I / M", abs(velocity), "m/s", positive=True)
         speed = free_recoil_speed(scene, velocity)

@@ -174,6 +174,9 @@ class LawFields:
     def __post_init__(self):
         super().__post_init__()
         check_law_fields(self, self.TABLE)
+        if self.law == "kelvin-voigt" and self.damping:  # the clipping surface p + (c/k) p' = 0
+            check_derived({f"{self.TABLE}.stiffness": self.stiffness, f"{self.TABLE}.damping": self.damping},
+                          "the relaxation time c / k", self.damping / self.stiffness, "s")
         if self.contact_law.restitution:
             keys = {f"{self.TABLE}.restitution": self.restitution}
             if self.law == "exact-restitution":  # chi lies in (0, 1/e): the root is bracketed with 1/e

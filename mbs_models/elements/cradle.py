@@ -107,7 +107,7 @@ import math
 from dataclasses import dataclass
 from typing import ClassVar
 
-from .barrel import BARREL, free_recoil_speed
+from .barrel import BARREL, free_recoil_speed, shot_keys
 from .connector import GROUND, Connector, Load
 from .ops import NUMPY_OPS, Ops
 from .table import Rule, Table, check_derived
@@ -165,7 +165,7 @@ class Cradle(Table):
             keys[f"{key}.friction_velocity"] = self.friction_velocity
             check_derived(keys, "the friction law's slope mu N / friction_velocity", friction / self.friction_velocity,
                           "N s/m")
-            check_derived(keys, "the free-recoil speed over friction_velocity (shots v0 / v_reg)",
+            check_derived({**keys, **shot_keys(scene)}, "the free-recoil speed over friction_velocity (shots v0 / v_reg)",
                           free_recoil_speed(scene) / self.friction_velocity)
 
     # ------------------------------------------------------------------ the element

@@ -389,8 +389,9 @@ class Burst(Table):
     def check_in_scene(self, scene, key: str) -> None:
         firing = scene.firing
         if firing is not None and firing.pulse is not None and firing.pulse.table[0][-1] >= self.interval:
-            raise SceneError(f"{key}.interval", f"must exceed the pulse's end ({firing.pulse.table[0][-1]:g} s): "
-                                                f"got {self.interval:g} s")
+            where = "firing.pulse.file" if firing.pulse.file is not None else "firing.pulse.times"
+            raise SceneError(f"{key}.interval", f"must exceed the pulse's end ({where} ends at "
+                                                f"{firing.pulse.table[0][-1]:g} s): got {self.interval:g} s")
 
     def bodies(self, scene, name: str) -> list:
         return []

@@ -34,7 +34,7 @@ from dataclasses import dataclass
 from typing import Any, ClassVar
 
 from ..errors import SceneError
-from .barrel import BARREL, free_recoil_speed
+from .barrel import BARREL, free_recoil_speed, shot_keys
 from .connector import GROUND, Connector
 from .ops import NUMPY_OPS, PYTHON_OPS, Ops, piecewise_linear
 from .table import Rule, Table, check_derived, check_number
@@ -163,7 +163,7 @@ class RecoilBrake(Table):
         """The brake's largest force at the barrel's free-recoil speed, ``K(a_min) (shots v0)^2``, must be finite."""
         area = self.smallest_area()
         keys = {f"{key}.piston_area": self.piston_area, f"{key}.discharge_coefficient": self.discharge_coefficient,
-                f"{key}.fluid_density": self.fluid_density, f"{key}.orifice_area": area, "barrel.mass": scene.barrel.mass}
+                f"{key}.fluid_density": self.fluid_density, f"{key}.orifice_area": area, **shot_keys(scene)}
         speed = free_recoil_speed(scene)
         check_derived(keys, "the brake's force at the barrel's free-recoil speed v, rho A^3 v^2 / (2 Cd^2 a_min^2)",
                       self.coefficient / (area * area) * speed * speed, "N")

@@ -69,7 +69,7 @@ from typing import ClassVar
 import numpy as np
 
 from ..errors import SceneError
-from .barrel import BARREL, free_recoil_energy
+from .barrel import BARREL, free_recoil_energy, shot_keys
 from .connector import GROUND, Connector
 from .ops import Ops
 from .table import Rule, Table, check_derived, ieee_power
@@ -145,11 +145,10 @@ class Recuperator(Table):
             d, self.polytropic_exponent + 1.0)
 
     def _ratio_power(self, d: float, exponent: float) -> float:
-        """``(V0 / (V0 - A d))^exponent`` as IEEE arithmetic gives it: inf where it overflows or the gas volume
-        rounds to 0 (Python's float arithmetic raises instead)."""
-        with np.errstate(divide="ignore"):
-            volume = np.float64(self.gas_volume)
-            return ieee_power(volume / (volume - np.float64(self.piston_area) * d), exponent)
+        """``(V0 / (V0 - A d))^exponent``: inf where it overflows or the gas volume ``V0 - A d`` rounds to 0 (Python's
+        float arithmetic raises instead)."""
+        remaining = self.gas_volume - self.piston_area * d
+        return ieee_power(self.gas_volume / remaining, exponent) if remaining > 0.0 else math.inf
 
     def __post_init__(self):
         super().__post_init__()
@@ -166,7 +165,7 @@ class Recuperator(Table):
         the gas must outlast the stroke to a recoil stop (module docstring, "Scene errors"); the force and the
         stiffness at the largest stroke the initial kinetic energy reaches (:meth:`connectors`) must be finite."""
         keys = {f"{key}.initial_pressure": self.initial_pressure, f"{key}.piston_area": self.piston_area,
-                f"{key}.gas_volume": self.gas_volume, "barrel.mass": scene.barrel.mass}
+                f"{key}.gas_volume": self.gas_volume, **shot_keys(scene)}
         stroke = max(self.stroke_at_energy(free_recoil_energy(scene)), 0.0)
         check_derived(keys, "the gas spring's force at the stroke U^-1(E) reaching the free-recoil energy E = "
                             "M (shots v0)^2 / 2", self.force(stroke), "N")
@@ -181,8 +180,9 @@ class Recuperator(Table):
             if self.preload <= resisting:
                 raise SceneError(f"{key}.initial_pressure",
                                  f"the preload p0 A = {self.preload:.6g} N cannot return the barrel to battery against "
-                                 f"gravity and friction M g (sin + mu cos) = {resisting:.6g} N at elevation "
-                                 f"{float(cradle.elevation):g} deg; raise p0 or A")
+                                 f"gravity and friction M g (sin + mu cos) = {resisting:.6g} N (barrel.mass = {mass:g} "
+                                 f"kg, cradle.gravity = {g:g} m/s^2, cradle.elevation = {float(cradle.elevation):g} deg, "
+                                 f"cradle.friction_coefficient = {mu:g}); raise p0 or A")
         if getattr(scene, "battery_stop", None) is None:
             raise SceneError("battery_stop", f"missing: the recuperator's preload p0 A = {self.preload:.6g} N pushes "
                                              "the barrel to battery and needs a [battery_stop] to rest on")
@@ -260,8 +260,9 @@ def held_position(scene, connectors) -> float:
         high, f_high = low, f_low
         step *= 2.0
         if step > 1e3:
-            raise SceneError("battery_stop", "nothing holds the barrel against the recuperator's preload within 1 km "
-                                             "of battery")
+            raise SceneError("battery_stop", "nothing holds the barrel against the recuperator's preload (p0 A: "
+                                             "recuperator.initial_pressure x recuperator.piston_area) within 1 km of "
+                                             "battery: the battery stop is too soft for it")
     root, status = brentq(f, low, high, xtol=1e-300, rtol=4.0 * np.finfo(float).eps, maxiter=_MAX_ITERATIONS,
                           full_output=True, disp=False)
     if not status.converged:

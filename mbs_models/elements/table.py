@@ -22,8 +22,6 @@ import sys
 from dataclasses import dataclass, fields
 from typing import Any, ClassVar, Iterable
 
-import numpy as np
-
 from ..errors import SceneError
 
 
@@ -98,11 +96,13 @@ def check_derived(values: dict[str, float], what: str, value: float, unit: str =
 
 
 def ieee_power(base: float, exponent: float) -> float:
-    """``base ** exponent`` (``base >= 0``) as IEEE arithmetic gives it -- inf where it overflows, 0 where it
-    underflows -- for derived quantities that :func:`check_derived` then judges (Python's float power raises
-    OverflowError instead)."""
-    with np.errstate(over="ignore", under="ignore", divide="ignore"):
-        return float(np.power(np.float64(base), np.float64(exponent)))
+    """``base ** exponent`` (floats, ``base >= 0``) as IEEE arithmetic gives it -- inf where it overflows -- for
+    quantities that :func:`check_derived` then judges (Python's float power raises OverflowError instead);
+    otherwise exactly Python's power."""
+    try:
+        return float(base) ** float(exponent)
+    except OverflowError:
+        return math.inf
 
 
 def check_choice(key: str, value, allowed: Iterable[str], what: str = "value") -> str:

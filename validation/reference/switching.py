@@ -64,7 +64,8 @@ def rearm_window(value: float, rate: float | None, noise: float, positive: bool)
     """Time (s) for a function sitting on its surface (``|value| <= noise``) to clear 100 noise levels."""
     if abs(value) > noise or rate is None or not (rate > 0) == positive or rate == 0:
         return 0.0
-    return min(100.0 * noise / abs(rate), 1e-8)
+    with np.errstate(over="ignore"):  # a rate too small for double precision: the window's cap
+        return min(100.0 * noise / abs(rate), 1e-8)
 
 
 def missed_crossing(dense, funcs, names, t0: float, t1: float):
