@@ -69,7 +69,7 @@ def test_the_test_extra_holds_what_the_tests_import():
     tested = project["dependencies"] + project["optional-dependencies"]["test"]
     provided = {canonicalize_name(Requirement(r).name) for r in tested}
     provided |= {"pytest", "packaging"}  # packaging comes with pytest
-    ours = {"mbs_models", "validation", "recorded", "conftest"}
+    ours = {"mbs_models", "validation", "recorded", "conftest", "extreme_values"}
     imported = set().union(*(_imported_top_level(p) for p in (ROOT / "tests").rglob("*.py")))
     third_party = {m for m in imported - ours if m not in sys.stdlib_module_names and not m.startswith("_")}
     modules = {"dask": "dask", "pyarrow": "pyarrow", "yaml": "pyyaml"}  # module name -> distribution
