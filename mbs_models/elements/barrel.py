@@ -15,13 +15,12 @@ from .table import Rule, Table, check_derived
 BARREL = "barrel"
 
 
-def free_recoil_speed(scene, velocity: float | None = None) -> float:
-    """``shots |v0|`` (m/s): the speed the shots of the scene give the barrel free of any force, its recoil velocity
-    ``v0 = I / M`` (``velocity`` if given; a pulse's ``impulse / M``) once per shot of a ``[burst]``."""
-    if velocity is None:
-        firing = getattr(scene, "firing", None)
-        velocity = scene.initial_velocity if firing is None or firing.pulse is None else \
-            firing.shot_momentum / scene.barrel.mass
+def free_recoil_speed(scene) -> float:
+    """``shots |v0|`` (m/s): the speed the shots of the scene give the barrel free of any force -- its recoil
+    velocity ``v0 = I / M`` (``barrel.initial_velocity``; a pulse's ``impulse / M``) once per shot of a ``[burst]``.
+    The paper's readings of v0 (rounded, or shared with an absorber) change it by less than a shot's own."""
+    firing = getattr(scene, "firing", None)
+    velocity = scene.barrel.initial_velocity if firing is None else firing.shot_momentum / scene.barrel.mass
     burst = getattr(scene, "burst", None)
     return abs(velocity) * (burst.shots if burst is not None else 1)
 
@@ -61,18 +60,15 @@ class Barrel(Table):
     RULES: ClassVar = {"mass": Rule(0.0, strict=True, unit="kg"), "initial_velocity": Rule(unit="m/s")}
 
     def check_in_scene(self, scene, key: str) -> None:
-        """The shot's recoil velocity ``v = I / M`` (or ``initial_velocity``; the pulse's impulse / M) must be
+        """The shot's recoil velocity ``v0 = I / M`` (or ``initial_velocity``; the pulse's impulse / M) must be
         finite (and not 0 when a firing momentum gives it), and the largest kinetic energy the shots give the
-        barrel, ``M (shots v)^2 / 2``, and ``(shots v)^2`` finite: a magnitude beyond double precision is bad
-        input (DESIGN.md, "Representable magnitudes")."""
-        firing = scene.firing
+        barrel, ``M (shots v0)^2 / 2``, and ``(shots v0)^2`` finite: a magnitude beyond double precision is bad
+        input (DESIGN.md, "Bad input beyond the ranges")."""
         keys = shot_keys(scene)
-        if firing is None:
-            velocity = scene.initial_velocity
-        else:
-            velocity = scene.initial_velocity if firing.pulse is None else firing.shot_momentum / self.mass
-            check_derived(keys, "the recoil velocity v0 = I / M", abs(velocity), "m/s", positive=True)
-        speed = free_recoil_speed(scene, velocity)
+        speed = free_recoil_speed(scene)
+        if scene.firing is not None:
+            check_derived(keys, "the recoil velocity v0 = I / M", scene.firing.shot_momentum / self.mass, "m/s",
+                          positive=True)
         check_derived(keys, "the square of the barrel's largest free-recoil speed (shots v0)^2", speed * speed, "m^2/s^2")
         check_derived(keys, "the barrel's largest kinetic energy M (shots v0)^2 / 2", 0.5 * self.mass * speed * speed, "J")
 

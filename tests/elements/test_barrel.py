@@ -9,7 +9,7 @@ import sys
 
 import pytest
 
-from mbs_models import Barrel, Firing, Scene, SceneError
+from mbs_models import Barrel, Conventions, Firing, Scene, SceneError
 from mbs_models.elements.firing import Burst, Pulse
 
 MOMENTUM = 6.86 * 564.0                       # I, kg m/s
@@ -61,3 +61,10 @@ def test_a_pulse_whose_impulse_over_the_mass_overflows_is_refused():
     """impulse = 1e300 N x 1 s / 2 = 5e299 N s on M = 1e-10 kg: v = 5e309 m/s."""
     pulse = Pulse(times=(0.0, 0.5, 1.0), forces=(0.0, 1e300, 0.0))
     refused("firing.pulse.forces", "recoil velocity", lambda: Scene(barrel=Barrel(1e-10), firing=Firing(pulse=pulse)))
+
+
+def test_a_v0_the_paper_s_rounding_takes_to_zero_is_no_precision_error():
+    """rounded_initial_velocity: I / M = 3869 / 1e6 = 0.0039 m/s prints as 0.0 m/s -- a reading, not an underflow."""
+    scene = Scene(barrel=Barrel(1e6), firing=Firing(projectile_mass=6.86, muzzle_velocity=564.0),
+                  conventions=Conventions(rounded_initial_velocity=True))
+    assert scene.initial_velocity == 0.0
