@@ -212,8 +212,7 @@ class Firing(Table):
             check_derived(self._momentum_keys(), "the firing momentum I = projectile_mass muzzle_velocity + "
                                                  "charge_mass gas_velocity", self.momentum, "kg m/s", positive=True)
         if self.pulse is not None and self.pulse.scale_to_momentum:
-            pulse_key = f"{self.TABLE}.pulse.{'file' if self.pulse.file is not None else 'forces'}"
-            keys = {**self._momentum_keys(), pulse_key: max(self.pulse.table[1])}
+            keys = {**self._momentum_keys(), **self._pulse_keys()}
             scale = check_derived(keys, "the scale of the pulse to the momentum, I / integral F dt",
                                   self.momentum / self.pulse.impulse, positive=True)
             check_derived(keys, "the peak of the pulse scaled to the momentum", scale * max(self.pulse.table[1]), "N")
@@ -230,6 +229,10 @@ class Firing(Table):
         projectile's, or the pulse's largest force (``firing.pulse.forces`` or ``firing.pulse.file``)."""
         if self.pulse is None or self.pulse.scale_to_momentum:
             return self._momentum_keys()
+        return self._pulse_keys()
+
+    def _pulse_keys(self) -> dict[str, float]:
+        """The pulse's forces (``firing.pulse.forces``, or ``firing.pulse.file``) with their largest (for errors)."""
         return {f"{self.TABLE}.pulse.{'file' if self.pulse.file is not None else 'forces'}": max(self.pulse.table[1])}
 
     @classmethod

@@ -163,7 +163,8 @@ class Recuperator(Table):
     def check_in_scene(self, scene, key: str) -> None:
         """The preload must hold the barrel in battery (against gravity and friction, on a battery stop) and
         the gas must outlast the stroke to a recoil stop (module docstring, "Scene errors"); the force and the
-        stiffness at the largest stroke the initial kinetic energy reaches (:meth:`connectors`) must be finite."""
+        stiffness at the stroke the barrel's free-recoil energy reaches must be finite (the stroke
+        :meth:`connectors` linearises at is no longer)."""
         keys = {f"{key}.initial_pressure": self.initial_pressure, f"{key}.piston_area": self.piston_area,
                 f"{key}.gas_volume": self.gas_volume, **shot_keys(scene)}
         stroke = max(self.stroke_at_energy(free_recoil_energy(scene)), 0.0)
