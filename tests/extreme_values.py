@@ -106,11 +106,12 @@ def with_value(old, value):
 
 
 def related(error: SceneError, key: str) -> bool:
-    """Does the error name ``key`` or a related key: the key's field in its message, or a key of the same table
-    (``absorber.1.contact.gap`` and ``absorber.1.mass``), or the key's table in its message?"""
+    """Does the error name ``key`` or a related key: a key of the same table (``absorber.1.contact.gap`` and
+    ``absorber.1.mass``), or ``key`` itself in its message (a quantity of several tables lists every key; the
+    message of a nested table's check names it from that table: ``contact.restitution``)?"""
     table = ".".join(key.split(".")[:2]) if key.startswith("absorber.") and key.split(".")[1].isdigit() \
         else key.split(".")[0]
-    return (key.split(".")[-1] in error.message or error.key.startswith(table) or table in error.message)
+    return error.key.startswith(table) or key in error.message or ".".join(key.split(".")[-2:]) in error.message
 
 
 def one_line(error: Exception) -> bool:
@@ -179,8 +180,10 @@ def run_cases(cases, timeout: float, directory: Path, solver: str = "engine") ->
     path.write_text("".join(json.dumps(list(case)) + "\n" for case in cases))
     out: list[tuple[tuple, str, str]] = []
     while len(out) < len(cases):
-        worker = subprocess.Popen([sys.executable, __file__, str(path), str(len(out)), solver], stdout=subprocess.PIPE,
-                                  stderr=subprocess.DEVNULL)
+        errors = directory / "worker.err"
+        with open(errors, "wb") as stderr:
+            worker = subprocess.Popen([sys.executable, __file__, str(path), str(len(out)), solver],
+                                      stdout=subprocess.PIPE, stderr=stderr)
         buffer = b""
         while len(out) < len(cases):
             deadline = time.monotonic() + timeout
@@ -194,8 +197,9 @@ def run_cases(cases, timeout: float, directory: Path, solver: str = "engine") ->
             if b"\n" not in buffer:
                 worker.kill()
                 worker.wait()
+                last = (errors.read_text(errors="replace").strip().splitlines() or [""])[-1]
                 out.append((cases[len(out)], "violation" if ended else "timeout",
-                            "the worker died" if ended else f"no outcome within {timeout:g} s"))
+                            f"the worker died: {last}" if ended else f"no outcome within {timeout:g} s"))
                 break
             line, buffer = buffer.split(b"\n", 1)
             outcome, detail = json.loads(line)
@@ -213,4 +217,5 @@ def _worker(path: str, start: int, solver: str) -> None:
 
 
 if __name__ == "__main__":
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent))  # validation/, not tests/validation/
     _worker(sys.argv[1], int(sys.argv[2]), sys.argv[3])

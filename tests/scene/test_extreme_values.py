@@ -26,7 +26,7 @@ from mbs_models.scenes import scene_path
 #: Cases of the fast sample, and its seed.
 SAMPLE, SEED = 120, 20
 #: Seconds a case may take before it is stopped (the slowest sampled case takes well under a second).
-TIMEOUT = 60.0
+TIMEOUT = 30.0
 
 
 def _judge(outcomes) -> None:
