@@ -37,7 +37,7 @@ from ..errors import SceneError
 from .barrel import BARREL, free_recoil_speed, shot_keys
 from .connector import GROUND, Connector
 from .ops import NUMPY_OPS, PYTHON_OPS, Ops, piecewise_linear
-from .table import Rule, Table, check_derived, check_number
+from .table import Rule, Table, check_derived, check_number, ieee_power
 
 #: The two fields that take a number or a table of (stroke, area) pairs.
 AREA_FIELDS = ("orifice_area", "counter_recoil_orifice_area")
@@ -142,8 +142,8 @@ class RecoilBrake(Table):
         A, cd = self.piston_area, self.discharge_coefficient
         keys = {f"{self.TABLE}.piston_area": A, f"{self.TABLE}.discharge_coefficient": cd,
                 f"{self.TABLE}.fluid_density": self.fluid_density}
-        check_derived(keys, "the cube of the piston area A^3", A * A * A, "m^6", positive=True)
-        check_derived(keys, "the square of the discharge coefficient Cd^2", cd * cd, positive=True)
+        check_derived(keys, "the cube of the piston area A^3", ieee_power(A, 3), "m^6", positive=True)
+        check_derived(keys, "the square of the discharge coefficient Cd^2", ieee_power(cd, 2), positive=True)
         coefficient = check_derived(keys, "the coefficient rho A^3 / (2 Cd^2)", self.coefficient, "kg m", positive=True)
         for name in AREA_FIELDS:
             area = getattr(self, name)
@@ -151,13 +151,13 @@ class RecoilBrake(Table):
                 continue
             areas = [a for _, a in area_points(area)]
             smallest = {**keys, f"{self.TABLE}.{name}": min(areas)}
-            check_derived(smallest, "the square of the smallest orifice area a^2", min(areas) * min(areas), "m^4",
-                          positive=True)
+            square = check_derived(smallest, "the square of the smallest orifice area a^2", ieee_power(min(areas), 2),
+                                   "m^4", positive=True)
             check_derived(smallest, "the brake's coefficient rho A^3 / (2 Cd^2 a^2) at the smallest area",
-                          coefficient / (min(areas) * min(areas)), "kg/m^3")
+                          coefficient / square, "kg/m^3")
             check_derived({**keys, f"{self.TABLE}.{name}": max(areas)},
                           "the brake's coefficient rho A^3 / (2 Cd^2 a^2) at the largest area",
-                          coefficient / (max(areas) * max(areas)), "kg/m^3", positive=True)
+                          coefficient / ieee_power(max(areas), 2), "kg/m^3", positive=True)
 
     def check_in_scene(self, scene, key: str) -> None:
         """The brake's largest force at the barrel's free-recoil speed, ``K(a_min) (shots v0)^2``, must be finite."""
@@ -166,13 +166,13 @@ class RecoilBrake(Table):
                 f"{key}.fluid_density": self.fluid_density, f"{key}.orifice_area": area, **shot_keys(scene)}
         speed = free_recoil_speed(scene)
         check_derived(keys, "the brake's force at the barrel's free-recoil speed v, rho A^3 v^2 / (2 Cd^2 a_min^2)",
-                      self.coefficient / (area * area) * speed * speed, "N")
+                      self.coefficient / ieee_power(area, 2) * ieee_power(speed, 2), "N")
 
     @property
     def coefficient(self) -> float:
-        """``rho A^3 / (2 Cd^2)`` in kg m (times ``v|v| / a^2`` it is the force)."""
-        A, cd = self.piston_area, self.discharge_coefficient
-        return self.fluid_density * (A * A * A) / (2.0 * (cd * cd))
+        """``rho A^3 / (2 Cd^2)`` in kg m (times ``v|v| / a^2`` it is the force; :meth:`_check_representable` keeps
+        the powers finite and > 0)."""
+        return self.fluid_density * self.piston_area ** 3 / (2.0 * self.discharge_coefficient ** 2)
 
     def smallest_area(self, d_bound: float = math.inf) -> float:
         """The smallest area (m^2) either branch has at strokes ``|x| <= d_bound`` (m)."""
@@ -227,8 +227,7 @@ class RecoilBrakeConnector(Connector):
         """``rho A^3 |v|max^2 / (2 Cd^2 a_min^2)`` (N), a_min over the strokes ``|x| <= d_bound``."""
         if rate_bound == 0.0:
             return 0.0
-        area = self.brake.smallest_area(d_bound)
-        return self.brake.coefficient * (rate_bound * rate_bound) / (area * area)
+        return self.brake.coefficient * rate_bound ** 2 / self.brake.smallest_area(d_bound) ** 2
 
     def largest_speed(self) -> float:
         """``sqrt(2 E0 / M)`` (m/s): the barrel's speed can never exceed what the initial energy E0 (J: kinetic
@@ -252,8 +251,7 @@ class RecoilBrakeConnector(Connector):
     def linear_damping(self) -> float:
         """The tangent damping ``dF/dv = 2 K |v|`` (N s/m) at its largest during the run: the smallest area
         and the largest speed (:meth:`largest_speed`), the stiffest linearisation a fixed step must survive."""
-        area = self.brake.smallest_area()
-        return 2.0 * self.brake.coefficient / (area * area) * self.largest_speed()
+        return 2.0 * self.brake.coefficient / self.brake.smallest_area() ** 2 * self.largest_speed()
 
     @property
     def first_step_limit(self) -> float:

@@ -93,14 +93,13 @@ def _free_recoil_reach(mechanism: Mechanism, bounds: EnergyBounds) -> list[float
     K = np.zeros((n, n))
     energy = np.zeros(n)  # per group root
     for i, body in enumerate(mechanism.bodies):
-        energy[root(i)] += 0.5 * body.mass * v0[i] * v0[i]
+        energy[root(i)] += 0.5 * body.mass * v0[i] ** 2
     for c in springs:
         if c.stores_energy:
             g = mechanism.direction(c)
             K += c.linear_stiffness * np.outer(g, g)
             body = c.b if c.b != GROUND else c.a
-            d0 = mechanism.relative_at(c, x0)
-            energy[root(index[body])] += 0.5 * c.linear_stiffness * d0 * d0
+            energy[root(index[body])] += 0.5 * c.linear_stiffness * mechanism.relative_at(c, x0) ** 2
     roots = sorted({root(i) for i in range(n)})
     members = {r: [i for i in range(n) if root(i) == r] for r in roots}
     out = []

@@ -315,8 +315,7 @@ class Scene:
     @property
     def initial_kinetic_energy(self) -> float:
         """Kinetic energy at t = 0 in J (the barrel alone moves)."""
-        velocity = self.initial_velocity
-        return 0.5 * self.barrel.mass * velocity * velocity
+        return 0.5 * self.barrel.mass * self.initial_velocity ** 2
 
     # ------------------------------------------------------------------ changes
     def with_changes(self, **changes) -> "Scene":
