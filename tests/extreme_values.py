@@ -197,6 +197,7 @@ def run_cases(cases, timeout: float, directory: Path, solver: str = "engine") ->
             if b"\n" not in buffer:
                 worker.kill()
                 worker.wait()
+                worker.stdout.close()
                 last = (errors.read_text(errors="replace").strip().splitlines() or [""])[-1]
                 out.append((cases[len(out)], "violation" if ended else "timeout",
                             f"the worker died: {last}" if ended else f"no outcome within {timeout:g} s"))
@@ -206,6 +207,7 @@ def run_cases(cases, timeout: float, directory: Path, solver: str = "engine") ->
             out.append((cases[len(out)], outcome, detail))
         else:
             worker.wait()
+            worker.stdout.close()
     return out
 
 

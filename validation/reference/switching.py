@@ -33,6 +33,11 @@ def heading(g, dg, ddg=0.0, tol=TOL_POS) -> bool:
     return ddg > 0
 
 
+class NonFiniteEvent(FloatingPointError):
+    """A switching function evaluated to NaN inside ``solve_ivp``'s event location: the solve fails
+    (:class:`~validation.reference.solver.ReferenceSolveError`), no root is sought in it."""
+
+
 def sided(g, t_start: float, positive: bool, window: float = 0.0):
     """Terminal event from ``g(t, y)`` watching the crossing that leaves the ``positive`` side.
 
@@ -49,6 +54,8 @@ def sided(g, t_start: float, positive: bool, window: float = 0.0):
 
     def fun(t, y):
         value = g(t, y)
+        if value != value:  # NaN: the dense output left the finite numbers (a diverging solution)
+            raise NonFiniteEvent(f"a switching function is NaN at t = {t:.9g} s")
         if sign * value > 0:
             seen[0] = True
         elif t - t_start <= window or (value == 0 and not seen[0]):
