@@ -207,7 +207,8 @@ class Scene:
                     continue
                 by = f"by {described(other)} and by {described(index)}" if other != index else \
                     f"by {described(index)} (its body and one of its connectors)"
-                raise SceneError(f"{key or elements[other][2]}.name",
+                named = key or elements[other][2]  # the absorber's key (two fixed names never collide)
+                raise SceneError(f"{named}.name" if named else element,
                                  f"the name {name!r} is taken twice, {by}: every body, connector, load and element "
                                  f"must have its own name (an absorber A adds the body A and the connectors A_damper "
                                  f"and A_contact; absorber_damper and contact if it is the only one)")
