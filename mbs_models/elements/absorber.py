@@ -35,7 +35,7 @@ from ..errors import SceneError
 from .barrel import BARREL
 from .connector import GROUND, Body, Connector
 from .contact_laws import Contact, ContactConnector
-from .table import Rule, Table, check_choice
+from .table import Rule, Table, check_choice, check_derived, ieee_power
 
 #: Allowed absorber mounts: ``"barrel"`` is the paper's model (i), ``"ground"`` its model (ii).
 MOUNTS = ("barrel", "ground")
@@ -92,6 +92,14 @@ class Absorber(Table):
         if self.contact is None:
             raise SceneError(f"{key}.contact", "missing: every absorber needs a contact with wall A "
                                                "([absorber.contact])")
+        if scene.conventions.literal_gap_sign and self.contact.gap > 0.0:  # an initial interference p(0) = gap
+            contact = self.contact
+            n = 1.0 if contact.exponent is None else contact.exponent
+            keys = {f"{key}.contact.gap": contact.gap, f"{key}.contact.stiffness": contact.stiffness}
+            check_derived(keys, "the initial interference's force k gap^n (conventions.literal_gap_sign)",
+                          contact.stiffness * ieee_power(contact.gap, n), "N")
+            check_derived(keys, "the initial interference's elastic energy k gap^(n+1) / (n+1)",
+                          contact.stiffness * ieee_power(contact.gap, n + 1.0) / (n + 1.0), "J")
 
     # ------------------------------------------------------------------ the element
     @staticmethod

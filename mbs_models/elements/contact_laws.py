@@ -53,7 +53,7 @@ import numpy as np
 from ..errors import SceneError
 from .connector import Connector
 from .ops import NUMPY_OPS, PYTHON_OPS, Ops
-from .table import Rule, Table, check_choice
+from .table import Rule, Table, check_choice, check_derived
 
 #: Restitution-law impacts slower than this (m/s) are damped as if they came at this speed.
 DEFAULT_MINIMUM_IMPACT_VELOCITY = 1e-3
@@ -174,6 +174,17 @@ class LawFields:
     def __post_init__(self):
         super().__post_init__()
         check_law_fields(self, self.TABLE)
+        if self.law == "kelvin-voigt" and self.damping:  # the clipping surface p + (c/k) p' = 0
+            check_derived({f"{self.TABLE}.stiffness": self.stiffness, f"{self.TABLE}.damping": self.damping},
+                          "the relaxation time c / k", self.damping / self.stiffness, "s")
+        if self.contact_law.restitution:
+            keys = {f"{self.TABLE}.restitution": self.restitution}
+            if self.law == "exact-restitution":  # chi lies in (0, 1/e): the root is bracketed with 1/e
+                check_derived(keys, "1 / restitution (the bound of chi)", 1.0 / self.restitution)
+            chi = check_derived(keys, "the restitution factor chi", self.restitution_factor)
+            keys[f"{self.TABLE}.minimum_impact_velocity"] = self.impact_velocity_floor
+            check_derived(keys, "the largest damping factor chi / minimum_impact_velocity",
+                          chi / self.impact_velocity_floor, "s/m")
 
     @classmethod
     def from_mapping(cls, data, key, version):

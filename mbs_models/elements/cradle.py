@@ -107,10 +107,10 @@ import math
 from dataclasses import dataclass
 from typing import ClassVar
 
-from .barrel import BARREL
+from .barrel import BARREL, free_recoil_speed, shot_keys
 from .connector import GROUND, Connector, Load
 from .ops import NUMPY_OPS, Ops
-from .table import Rule, Table
+from .table import Rule, Table, check_derived
 
 #: Default regularisation velocity of the friction law (m/s): see the module docstring.
 DEFAULT_FRICTION_VELOCITY = 1.0e-4
@@ -152,6 +152,21 @@ class Cradle(Table):
         ``cos(+-90 deg)`` is taken as exactly 0 (no normal force on a vertical cradle)."""
         cosine = 0.0 if abs(self.elevation) == 90.0 else math.cos(math.radians(self.elevation))
         return self.friction_coefficient * mass * self.gravity * cosine
+
+    def check_in_scene(self, scene, key: str) -> None:
+        """The barrel's weight along the axis ``M g sin``, the friction ``mu M g cos``, the law's slope in its band
+        ``mu N / v_reg`` and the free-recoil speed in units of ``v_reg`` (what the law divides) must be finite."""
+        mass = scene.barrel.mass
+        keys = {"barrel.mass": mass, f"{key}.gravity": self.gravity}
+        check_derived(keys, "the barrel's weight along the recoil axis M g sin(elevation)", self.weight_along(mass), "N")
+        keys[f"{key}.friction_coefficient"] = self.friction_coefficient
+        friction = check_derived(keys, "the friction force mu M g cos(elevation)", self.friction_force(mass), "N")
+        if friction > 0.0:
+            keys[f"{key}.friction_velocity"] = self.friction_velocity
+            check_derived(keys, "the friction law's slope mu N / friction_velocity", friction / self.friction_velocity,
+                          "N s/m")
+            check_derived({**keys, **shot_keys(scene)}, "the free-recoil speed over friction_velocity (shots v0 / v_reg)",
+                          free_recoil_speed(scene) / self.friction_velocity)
 
     # ------------------------------------------------------------------ the element
     def bodies(self, scene, name: str) -> list:

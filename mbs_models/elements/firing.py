@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import contextvars
 import csv
+import io
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -41,10 +42,11 @@ from typing import ClassVar
 import numpy as np
 
 from ..errors import SceneError
+from ..inputs import read_text_file
 from .barrel import BARREL
 from .connector import Load
 from .ops import LinearPieces, NumpyPiecewiseLinear, Ops, piecewise_linear
-from .table import Rule, Table, check_number
+from .table import Rule, Table, check_derived, check_number
 
 #: The directory that relative file names in a scene (``firing.pulse.file``) resolve against: the
 #: scene file's directory while :func:`mbs_models.load_scene` reads it, else the working directory.
@@ -71,17 +73,19 @@ def _number_list(key: str, values, rule: Rule) -> tuple[float, ...]:
 
 
 def read_pulse_file(path: Path, key: str) -> tuple[tuple[float, ...], tuple[float, ...]]:
-    """(times s, forces N) from a CSV file of two columns ``time,force`` after one header line."""
+    """(times s, forces N) from a CSV file of two columns ``time,force`` after one header line: a regular UTF-8
+    text file of at most :data:`~mbs_models.inputs.MAX_INPUT_BYTES` (:func:`~mbs_models.inputs.read_text_file`:
+    no device such as ``/dev/zero``, directory or pipe) with at most :data:`MAX_PULSE_POINTS` points."""
+    text = read_text_file(path, key, "pulse file")
     rows = []
     try:
-        with open(path, newline="", encoding="utf-8") as handle:
-            for row in csv.reader(handle):
-                if row and any(cell.strip() for cell in row):
-                    rows.append(row)
-                    if len(rows) > MAX_PULSE_POINTS + 1:  # the header and the points
-                        raise _too_many_points(key, f"{path} has")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise SceneError(key, f"cannot read the pulse file {path}: {exc}") from None
+        for row in csv.reader(io.StringIO(text, newline="")):
+            if row and any(cell.strip() for cell in row):
+                rows.append(row)
+                if len(rows) > MAX_PULSE_POINTS + 1:  # the header and the points
+                    raise _too_many_points(key, f"{path} has")
+    except csv.Error as exc:  # a field beyond csv's limit (128 KiB), a NUL byte
+        raise SceneError(key, f"{path}: not a CSV table of two columns time,force: {exc}") from None
     if len(rows) < 3:
         raise SceneError(key, f"{path}: needs a header line and at least two rows time,force")
     times, forces = [], []
@@ -92,8 +96,14 @@ def read_pulse_file(path: Path, key: str) -> tuple[tuple[float, ...], tuple[floa
             times.append(float(row[0]))
             forces.append(float(row[1]))
         except ValueError:
-            raise SceneError(key, f"{path} line {line}: not numbers: {','.join(row)!r}") from None
+            raise SceneError(key, f"{path} line {line}: not numbers: {','.join(row)[:80]!r}") from None
     return tuple(times), tuple(forces)
+
+
+def _impulse(t, f) -> float:
+    """``integral F dt`` (N s) of the piecewise-linear force through ``(t, f)``: the trapezoidal sum (halves taken
+    first: a sum of two forces near the largest double does not overflow)."""
+    return sum((0.5 * f[i] + 0.5 * f[i + 1]) * (t[i + 1] - t[i]) for i in range(len(t) - 1))
 
 
 @dataclass(frozen=True)
@@ -145,6 +155,9 @@ class Pulse(Table):
                 raise SceneError(f"{key}.times.{i}", f"must increase: {times[i]:g} s after {times[i - 1]:g} s")
         if not any(f > 0 for f in forces):
             raise SceneError(f"{key}.forces", "are all 0: the pulse does nothing")
+        where = f"{key}.file" if self.file is not None else f"{key}.forces"
+        check_derived({where: max(forces), f"{key}.times": times[-1] - times[0]},
+                      "the pulse's impulse integral F dt", _impulse(times, forces), "N s", positive=True)
         if self.file is None:
             object.__setattr__(self, "times", times)
             object.__setattr__(self, "forces", forces)
@@ -158,8 +171,7 @@ class Pulse(Table):
     @property
     def impulse(self) -> float:
         """``integral F dt`` (N s) of the table as given (trapezoidal: exact for a piecewise-linear force)."""
-        t, f = self.table
-        return sum(0.5 * (f[i] + f[i + 1]) * (t[i + 1] - t[i]) for i in range(len(t) - 1))
+        return _impulse(*self.table)
 
     @property
     def duration(self) -> float:
@@ -214,6 +226,32 @@ class Firing(Table):
             raise SceneError(f"{self.TABLE}.gas_velocity", "missing: a charge_mass > 0 needs the gas velocity (m/s)")
         if self.charge_mass > 0 and self.projectile_mass is None:
             raise SceneError(f"{self.TABLE}.projectile_mass", "missing: the charge's momentum adds to the projectile's")
+        if self.projectile_mass is not None:
+            check_derived(self._momentum_keys(), "the firing momentum I = projectile_mass muzzle_velocity + "
+                                                 "charge_mass gas_velocity", self.momentum, "kg m/s", positive=True)
+        if self.pulse is not None and self.pulse.scale_to_momentum:
+            keys = {**self._momentum_keys(), **self._pulse_keys()}
+            scale = check_derived(keys, "the scale of the pulse to the momentum, I / integral F dt",
+                                  self.momentum / self.pulse.impulse, positive=True)
+            check_derived(keys, "the peak of the pulse scaled to the momentum", scale * max(self.pulse.table[1]), "N")
+
+    def _momentum_keys(self) -> dict[str, float]:
+        """The keys the momentum depends on, with their values (for errors)."""
+        keys = {f"{self.TABLE}.projectile_mass": self.projectile_mass, f"{self.TABLE}.muzzle_velocity": self.muzzle_velocity}
+        if self.charge_mass > 0:
+            keys.update({f"{self.TABLE}.charge_mass": self.charge_mass, f"{self.TABLE}.gas_velocity": self.gas_velocity})
+        return keys
+
+    def shot_keys(self) -> dict[str, float]:
+        """The keys :attr:`shot_momentum` depends on, with their values (for errors naming them): the
+        projectile's, or the pulse's largest force (``firing.pulse.forces`` or ``firing.pulse.file``)."""
+        if self.pulse is None or self.pulse.scale_to_momentum:
+            return self._momentum_keys()
+        return self._pulse_keys()
+
+    def _pulse_keys(self) -> dict[str, float]:
+        """The pulse's forces (``firing.pulse.forces``, or ``firing.pulse.file``) with their largest (for errors)."""
+        return {f"{self.TABLE}.pulse.{'file' if self.pulse.file is not None else 'forces'}": max(self.pulse.table[1])}
 
     @classmethod
     def required_keys(cls) -> tuple[str, ...]:
@@ -361,6 +399,8 @@ class Burst(Table):
         if not 1 <= self.shots <= 1000:
             raise SceneError(f"{self.TABLE}.shots", f"must be in [1, 1000], got {self.shots}")
         super().__post_init__()
+        check_derived({f"{self.TABLE}.interval": self.interval, f"{self.TABLE}.shots": self.shots},
+                      "the end of the last shot's interval, shots x interval", self.shots * self.interval, "s")
 
     @property
     def shot_times(self) -> tuple[float, ...]:
@@ -370,8 +410,9 @@ class Burst(Table):
     def check_in_scene(self, scene, key: str) -> None:
         firing = scene.firing
         if firing is not None and firing.pulse is not None and firing.pulse.table[0][-1] >= self.interval:
-            raise SceneError(f"{key}.interval", f"must exceed the pulse's end ({firing.pulse.table[0][-1]:g} s): "
-                                                f"got {self.interval:g} s")
+            where = "firing.pulse.file" if firing.pulse.file is not None else "firing.pulse.times"
+            raise SceneError(f"{key}.interval", f"must exceed the pulse's end ({where} ends at "
+                                                f"{firing.pulse.table[0][-1]:g} s): got {self.interval:g} s")
 
     def bodies(self, scene, name: str) -> list:
         return []

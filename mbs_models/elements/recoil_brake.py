@@ -34,10 +34,10 @@ from dataclasses import dataclass
 from typing import Any, ClassVar
 
 from ..errors import SceneError
-from .barrel import BARREL
+from .barrel import BARREL, free_recoil_speed, shot_keys
 from .connector import GROUND, Connector
 from .ops import NUMPY_OPS, PYTHON_OPS, Ops, piecewise_linear
-from .table import Rule, Table, check_number
+from .table import Rule, Table, check_derived, check_number, ieee_power
 
 #: The two fields that take a number or a table of (stroke, area) pairs.
 AREA_FIELDS = ("orifice_area", "counter_recoil_orifice_area")
@@ -134,10 +134,44 @@ class RecoilBrake(Table):
             value = getattr(self, name)
             if value is not None or name == "orifice_area":
                 object.__setattr__(self, name, check_area(f"{self.TABLE}.{name}", value))
+        self._check_representable()
+
+    def _check_representable(self) -> None:
+        """Every factor of the law ``K(a) = rho A^3 / (2 Cd^2 a^2)`` finite and > 0 as the law computes it, for
+        the smallest and the largest area: a brake double precision cannot represent is bad input."""
+        A, cd = self.piston_area, self.discharge_coefficient
+        keys = {f"{self.TABLE}.piston_area": A, f"{self.TABLE}.discharge_coefficient": cd,
+                f"{self.TABLE}.fluid_density": self.fluid_density}
+        check_derived(keys, "the cube of the piston area A^3", ieee_power(A, 3), "m^6", positive=True)
+        check_derived(keys, "the square of the discharge coefficient Cd^2", ieee_power(cd, 2), positive=True)
+        coefficient = check_derived(keys, "the coefficient rho A^3 / (2 Cd^2)", self.coefficient, "kg m", positive=True)
+        for name in AREA_FIELDS:
+            area = getattr(self, name)
+            if area is None:
+                continue
+            areas = [a for _, a in area_points(area)]
+            smallest = {**keys, f"{self.TABLE}.{name}": min(areas)}
+            square = check_derived(smallest, "the square of the smallest orifice area a^2", ieee_power(min(areas), 2),
+                                   "m^4", positive=True)
+            check_derived(smallest, "the brake's coefficient rho A^3 / (2 Cd^2 a^2) at the smallest area",
+                          coefficient / square, "kg/m^3")
+            check_derived({**keys, f"{self.TABLE}.{name}": max(areas)},
+                          "the brake's coefficient rho A^3 / (2 Cd^2 a^2) at the largest area",
+                          coefficient / ieee_power(max(areas), 2), "kg/m^3", positive=True)
+
+    def check_in_scene(self, scene, key: str) -> None:
+        """The brake's largest force at the barrel's free-recoil speed, ``K(a_min) (shots v0)^2``, must be finite."""
+        area = self.smallest_area()
+        keys = {f"{key}.piston_area": self.piston_area, f"{key}.discharge_coefficient": self.discharge_coefficient,
+                f"{key}.fluid_density": self.fluid_density, f"{key}.orifice_area": area, **shot_keys(scene)}
+        speed = free_recoil_speed(scene)
+        check_derived(keys, "the brake's force at the barrel's free-recoil speed v, rho A^3 v^2 / (2 Cd^2 a_min^2)",
+                      self.coefficient / ieee_power(area, 2) * ieee_power(speed, 2), "N")
 
     @property
     def coefficient(self) -> float:
-        """``rho A^3 / (2 Cd^2)`` in kg m (times ``v|v| / a^2`` it is the force)."""
+        """``rho A^3 / (2 Cd^2)`` in kg m (times ``v|v| / a^2`` it is the force; :meth:`_check_representable` keeps
+        the powers finite and > 0)."""
         return self.fluid_density * self.piston_area ** 3 / (2.0 * self.discharge_coefficient ** 2)
 
     def smallest_area(self, d_bound: float = math.inf) -> float:

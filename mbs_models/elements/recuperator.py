@@ -69,10 +69,10 @@ from typing import ClassVar
 import numpy as np
 
 from ..errors import SceneError
-from .barrel import BARREL
+from .barrel import BARREL, free_recoil_energy, shot_keys
 from .connector import GROUND, Connector
 from .ops import Ops
-from .table import Rule, Table
+from .table import Rule, Table, check_derived, ieee_power
 
 #: Polytropic exponents accepted: from isothermal (1) to the adiabatic exponent of a monatomic ideal gas
 #: (5/3, rounded up to 1.67); nitrogen, the usual recuperator gas, is 1.4 adiabatic.
@@ -116,8 +116,8 @@ class Recuperator(Table):
         return self.gas_volume / self.piston_area
 
     def force(self, d: float) -> float:
-        """``F(d) = p0 A (V0 / (V0 - A d))^n`` in N at the stroke ``d`` (m, < V0/A)."""
-        return self.preload * (self.gas_volume / (self.gas_volume - self.piston_area * d)) ** self.polytropic_exponent
+        """``F(d) = p0 A (V0 / (V0 - A d))^n`` in N at the stroke ``d`` (m, < V0/A); inf where it overflows."""
+        return self.preload * self._ratio_power(d, self.polytropic_exponent)
 
     def stored_energy(self, d):
         """``U(d)`` in J (numpy or float; module docstring): ``p0 V0 expm1((n-1) ln r) / (n-1)``, ``p0 V0 ln r``."""
@@ -140,15 +140,38 @@ class Recuperator(Table):
         return -self.exhausted_at * math.expm1(-log_r)  # d = V0/A (1 - 1/r)
 
     def tangent_stiffness(self, d: float) -> float:
-        """``dF/dd = n p0 A^2 / V0 (V0 / (V0 - A d))^(n+1)`` in N/m."""
-        r = self.gas_volume / (self.gas_volume - self.piston_area * d)
-        return self.polytropic_exponent * self.preload * self.piston_area / self.gas_volume * r ** (
-            self.polytropic_exponent + 1.0)
+        """``dF/dd = n p0 A^2 / V0 (V0 / (V0 - A d))^(n+1)`` in N/m; inf where it overflows."""
+        return self.polytropic_exponent * self.preload * self.piston_area / self.gas_volume * self._ratio_power(
+            d, self.polytropic_exponent + 1.0)
+
+    def _ratio_power(self, d: float, exponent: float) -> float:
+        """``(V0 / (V0 - A d))^exponent``: inf where it overflows or the gas volume ``V0 - A d`` rounds to 0 (Python's
+        float arithmetic raises instead)."""
+        remaining = self.gas_volume - self.piston_area * d
+        return ieee_power(self.gas_volume / remaining, exponent) if remaining > 0.0 else math.inf
+
+    def __post_init__(self):
+        super().__post_init__()
+        keys = {f"{self.TABLE}.initial_pressure": self.initial_pressure, f"{self.TABLE}.piston_area": self.piston_area,
+                f"{self.TABLE}.gas_volume": self.gas_volume}
+        check_derived(keys, "the preload p0 A", self.preload, "N", positive=True)
+        check_derived(keys, "the energy scale p0 V0", self.initial_pressure * self.gas_volume, "J", positive=True)
+        check_derived(keys, "the stroke that would exhaust the gas V0 / A", self.exhausted_at, "m", positive=True)
+        check_derived(keys, "the stiffness at battery n p0 A^2 / V0", self.tangent_stiffness(0.0), "N/m", positive=True)
 
     # ------------------------------------------------------------------ scene checks
     def check_in_scene(self, scene, key: str) -> None:
         """The preload must hold the barrel in battery (against gravity and friction, on a battery stop) and
-        the gas must outlast the stroke to a recoil stop (module docstring, "Scene errors")."""
+        the gas must outlast the stroke to a recoil stop (module docstring, "Scene errors"); the force and the
+        stiffness at the stroke the barrel's free-recoil energy reaches must be finite (the stroke
+        :meth:`connectors` linearises at is no longer)."""
+        keys = {f"{key}.initial_pressure": self.initial_pressure, f"{key}.piston_area": self.piston_area,
+                f"{key}.gas_volume": self.gas_volume, **shot_keys(scene)}
+        stroke = max(self.stroke_at_energy(free_recoil_energy(scene)), 0.0)
+        check_derived(keys, "the gas spring's force at the stroke U^-1(E) reaching the free-recoil energy E = "
+                            "M (shots v0)^2 / 2", self.force(stroke), "N")
+        check_derived(keys, "the gas spring's stiffness at the stroke reaching the free-recoil energy",
+                      self.tangent_stiffness(stroke), "N/m")
         mass = scene.barrel.mass
         cradle = getattr(scene, "cradle", None)
         if cradle is not None:
@@ -158,8 +181,9 @@ class Recuperator(Table):
             if self.preload <= resisting:
                 raise SceneError(f"{key}.initial_pressure",
                                  f"the preload p0 A = {self.preload:.6g} N cannot return the barrel to battery against "
-                                 f"gravity and friction M g (sin + mu cos) = {resisting:.6g} N at elevation "
-                                 f"{float(cradle.elevation):g} deg; raise p0 or A")
+                                 f"gravity and friction M g (sin + mu cos) = {resisting:.6g} N (barrel.mass = {mass:g} "
+                                 f"kg, cradle.gravity = {g:g} m/s^2, cradle.elevation = {float(cradle.elevation):g} deg, "
+                                 f"cradle.friction_coefficient = {mu:g}); raise p0 or A")
         if getattr(scene, "battery_stop", None) is None:
             raise SceneError("battery_stop", f"missing: the recuperator's preload p0 A = {self.preload:.6g} N pushes "
                                              "the barrel to battery and needs a [battery_stop] to rest on")
@@ -199,6 +223,11 @@ def gravity_load(scene) -> float:
     return scene.barrel.mass * float(cradle.gravity) * math.sin(math.radians(float(cradle.elevation)))
 
 
+#: Brent's method's iterations for the held position: bisecting the bracket (at most 1 km) down to 1e-300 m takes
+#: about 1010 halvings, Brent's method at most a few times its bisection count.
+_MAX_ITERATIONS = 4000
+
+
 def held_position(scene, connectors) -> float:
     """The barrel's static equilibrium x0 (m) on what holds it at battery.
 
@@ -232,9 +261,16 @@ def held_position(scene, connectors) -> float:
         high, f_high = low, f_low
         step *= 2.0
         if step > 1e3:
-            raise SceneError("battery_stop", "nothing holds the barrel against the recuperator's preload within 1 km "
-                                             "of battery")
-    return float(brentq(f, low, high, xtol=1e-300, rtol=4.0 * np.finfo(float).eps, maxiter=500))
+            raise SceneError("battery_stop", "nothing holds the barrel against the recuperator's preload (p0 A: "
+                                             "recuperator.initial_pressure x recuperator.piston_area) within 1 km of "
+                                             "battery: the battery stop is too soft for it")
+    root, status = brentq(f, low, high, xtol=1e-300, rtol=4.0 * np.finfo(float).eps, maxiter=_MAX_ITERATIONS,
+                          full_output=True, disp=False)
+    if not status.converged:
+        raise SceneError("recuperator.gas_volume", f"the static equilibrium in battery is not resolved in double "
+                                                   f"precision ({status.flag} in [{low:g}, {high:g}] m): the gas "
+                                                   f"spring's force falls from the preload within V0 / A")
+    return float(root)
 
 
 class RecuperatorConnector(Connector):

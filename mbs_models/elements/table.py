@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import difflib
 import math
+import sys
 from dataclasses import dataclass, fields
 from typing import Any, ClassVar, Iterable
 
@@ -53,6 +54,9 @@ def check_number(key: str, value, rule: Rule = Rule()) -> float:
     """Return ``value`` as float, or raise SceneError naming ``key`` and the allowed range."""
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise SceneError(key, f"must be a number, got {type(value).__name__} {value!r}")
+    if isinstance(value, int) and abs(value) > sys.float_info.max:  # float() would raise OverflowError
+        raise SceneError(key, f"must be a finite number ({rule.describe()}), got an integer beyond the largest "
+                              f"double ({sys.float_info.max:.4g})")
     value = float(value)
     if not math.isfinite(value):
         raise SceneError(key, f"must be a finite number, got {value}")
@@ -64,6 +68,41 @@ def check_number(key: str, value, rule: Rule = Rule()) -> float:
             raise SceneError(key, f"must be {rule.describe()}, got {value:g}")
         raise SceneError(key, f"must be {rule.describe()}, got {value:g}")
     return value
+
+
+def culprit(values: dict[str, float]) -> str:
+    """The key (of ``{key: value}``, the keys a derived quantity depends on) whose value lies farthest from 1 in
+    magnitude (``|log |value||`` largest; 0 counts as the farthest): the likeliest slip when the quantity is not
+    representable."""
+    def distance(item):
+        value = abs(float(item[1]))
+        return math.inf if value == 0.0 or not math.isfinite(value) else abs(math.log(value))
+    return max(values.items(), key=distance)[0]
+
+
+def check_derived(values: dict[str, float], what: str, value: float, unit: str = "", *,
+                  positive: bool = False) -> float:
+    """``value`` -- a quantity the model derives from the keys ``values`` (``{key: value}``; ``what`` names it and
+    gives its formula) -- if double precision represents it: finite, and > 0 if ``positive`` (a product of
+    positive numbers that underflows to 0).  Otherwise a SceneError naming the key of :func:`culprit` and every
+    key with its value: a magnitude the model cannot represent is bad input, never clamped."""
+    if math.isfinite(value) and (value > 0.0 or not positive):
+        return value
+    allowed = f"finite and > 0 (in [{5e-324:g}, {sys.float_info.max:.4g}]{' ' + unit if unit else ''})" if positive \
+        else f"finite (|x| <= {sys.float_info.max:.4g}{' ' + unit if unit else ''})"
+    given = ", ".join(f"{key} = {number:g}" for key, number in values.items())
+    raise SceneError(culprit(values), f"{what} = {value:g}{' ' + unit if unit else ''} is beyond double precision: "
+                                      f"it must be {allowed}; from {given}")
+
+
+def ieee_power(base: float, exponent: float) -> float:
+    """``base ** exponent`` (floats, ``base >= 0``) as IEEE arithmetic gives it -- inf where it overflows -- for
+    quantities that :func:`check_derived` then judges (Python's float power raises OverflowError instead);
+    otherwise exactly Python's power."""
+    try:
+        return float(base) ** float(exponent)
+    except OverflowError:
+        return math.inf
 
 
 def check_choice(key: str, value, allowed: Iterable[str], what: str = "value") -> str:

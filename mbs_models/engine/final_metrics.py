@@ -171,7 +171,8 @@ class _QuadraticForm:
         if outside.size and float(np.max(np.abs(outside))) > 1e-9 * max(float(np.max(np.abs(g))), 1.0):
             return math.inf
         inside = components[self._keep]
-        return 2.0 * float(np.sum(inside * inside / self._values[self._keep]))
+        with np.errstate(over="ignore"):  # a spring too weak for double precision: no bound (inf)
+            return 2.0 * float(np.sum(inside * inside / self._values[self._keep]))
 
     def null_space(self) -> np.ndarray:
         """Orthonormal columns spanning K's null space (the position changes no spring resists), shape

@@ -121,7 +121,8 @@ def _free_recoil_reach(mechanism: Mechanism, bounds: EnergyBounds) -> list[float
             if np.any(np.abs(components[~keep]) > 1e-9 * float(np.max(np.abs(g_c)))):
                 reach = math.inf  # a direction without a spring: no bound
                 break
-            coefficient = 2.0 * float(np.sum(components[keep] ** 2 / values[keep]))
+            with np.errstate(over="ignore"):  # a spring too weak for double precision: no bound (inf)
+                coefficient = 2.0 * float(np.sum(components[keep] ** 2 / values[keep]))
             reach += math.sqrt(coefficient * energy[r] * (1.0 + ENERGY_SLACK))
         out.append(reach)
     return out

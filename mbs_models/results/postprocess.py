@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..elements.barrel import BARREL
+from ..errors import SimulationError
 from .energies import Energies, cumulative_quadrature, energies  # noqa: F401  (re-exported)
 from .peaks import refine_crossing, refine_maximum
 from .refinement import Episodes, refine
@@ -102,8 +103,43 @@ def analyse(mechanism, s: Samples, impact_threshold: float, wanted: tuple[str, .
     """Compute the metrics of a solve from its samples: those in ``wanted``, and always the energies.
 
     Metrics left out are None (a contact's peak and impacts share one search: asking for either
-    computes both).
+    computes both).  Finite samples may still give forces, powers or energies beyond double precision (a solve
+    that diverged to states the model cannot represent): that is a :class:`~mbs_models.errors.SimulationError`
+    naming the quantity (:func:`check_representable`), never a numpy warning or an inf/NaN result.
     """
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        metrics = _analyse(mechanism, s, impact_threshold, wanted)
+    check_representable(metrics, s)
+    return metrics
+
+
+def check_representable(metrics: Metrics, s: Samples) -> None:
+    """SimulationError naming the first quantity of ``metrics`` that is not finite: the support force, a contact's
+    force or peak, an energy history, or the energy balance's sum ``kinetic + stored + dissipated - work`` (the
+    order the balance is computed in)."""
+    quantities = [("force on the mount", metrics.support_force), ("maximum barrel displacement",
+                                                                  metrics.max_barrel_displacement),
+                  ("peak force on the mount", metrics.peak_support_force)]
+    quantities += [(f"maximum velocity of {name}", value) for name, (value, _) in metrics.max_velocity.items()]
+    for contact in metrics.contacts.values():
+        quantities += [(f"force of {contact.name}", contact.force), (f"peak force of {contact.name}", contact.peak_force)]
+    energy = metrics.energies
+    for kind in ("kinetic", "stored", "dissipated", "work"):
+        quantities += [(f"{kind} energy of {name}", history) for name, history in getattr(energy, kind).items()]
+    with np.errstate(over="ignore", invalid="ignore"):
+        balance = np.zeros_like(s.time)
+        for kind in ("kinetic", "stored", "dissipated"):
+            balance = balance + sum(getattr(energy, kind).values(), np.zeros_like(s.time))
+        balance = balance - sum(energy.work.values(), np.zeros_like(s.time))
+    quantities.append(("sum of the energies (kinetic + stored + dissipated - work)", balance))
+    for what, value in quantities:
+        if value is not None and not np.all(np.isfinite(value)):
+            speed = max(float(np.max(np.abs(v))) for v in s.velocities.values())
+            raise SimulationError(f"the {what} is beyond double precision (the solve reached speeds up to {speed:.3g} "
+                                  f"m/s): the solution diverged to states the model cannot represent")
+
+
+def _analyse(mechanism, s: Samples, impact_threshold: float, wanted: tuple[str, ...]) -> Metrics:
     interp = Interpolant(s)
     metrics = Metrics()
     if "max_barrel_displacement" in wanted:

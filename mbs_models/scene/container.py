@@ -157,14 +157,16 @@ class Scene:
             raise SceneError("barrel.initial_velocity",
                              "give either barrel.initial_velocity or a [firing] table, not both")
         names = self.absorber_names()
-        if len(set(names)) != len(names):
-            duplicate = next(n for n in names if names.count(n) > 1)
-            raise SceneError("absorber.name", f"{duplicate!r} names two absorbers: names must be unique")
+        keys = [key for key, _ in self._absorber_keys()]
+        for i, name in enumerate(names):
+            if name in names[:i]:
+                raise SceneError(f"{keys[i]}.name", f"{name!r} names two absorbers: names must be unique")
         for key, table in self.tables():
             try:
                 table.check_in_scene(self, key)
             except SceneError as exc:
                 raise exc from None
+        self._check_item_names()
         conventions = self.conventions
         if conventions.v0_includes_absorber and self.firing is None:
             raise SceneError("conventions.v0_includes_absorber",
@@ -177,6 +179,39 @@ class Scene:
                                                                 f"{key}.contact.law is {absorber.contact.law!r}")
         if conventions.compression_only and len(self.absorbers) > 1:
             raise SceneError("conventions.compression_only", "needs a scene with one absorber")
+
+    def _check_item_names(self) -> None:
+        """Every body, connector and load of the assembled mechanism has its own name, and no element is named
+        like another element's item: outputs are keyed by these names and ``Result.energy()`` groups them by
+        element, so a shared name would merge or misattribute entries.  Only an absorber's name is the user's
+        (the other elements' names are fixed and distinct), so this runs when one is named; the error names
+        that absorber's key (``absorber.N.name``)."""
+        if not any(absorber.name for absorber in self.absorbers):
+            return
+        absorber_keys = iter(key for key, _ in self._absorber_keys())
+        elements = [(name, table, next(absorber_keys) if isinstance(table, Absorber) else None)
+                    for name, table in self.elements()]
+
+        def described(index: int) -> str:
+            name, _, key = elements[index]
+            return f"absorber {name!r}" if key is not None else f"the [{name}] element"
+
+        owner: dict[str, int] = {}  # a name -> the index of the element that uses it
+        for index, (element, table, key) in enumerate(elements):
+            items = [b.name for b in table.bodies(self, element)] + [c.name for c in table.connectors(self, element)]
+            if hasattr(table, "loads"):
+                items += [load.name for load in table.loads(self, element)]
+            for name in [element] + items:
+                other = owner.setdefault(name, index)
+                if other == index and items.count(name) <= 1:
+                    continue
+                by = f"by {described(other)} and by {described(index)}" if other != index else \
+                    f"by {described(index)} (its body and one of its connectors)"
+                named = key or elements[other][2]  # the absorber's key (two fixed names never collide)
+                raise SceneError(f"{named}.name" if named else element,
+                                 f"the name {name!r} is taken twice, {by}: every body, connector, load and element "
+                                 f"must have its own name (an absorber A adds the body A and the connectors A_damper "
+                                 f"and A_contact; absorber_damper and contact if it is the only one)")
 
     # ------------------------------------------------------------------ tables
     def __getattr__(self, name: str):

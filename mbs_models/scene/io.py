@@ -19,7 +19,6 @@ the key as it stands in the file (``contact.gap``, ``absorber.1.contact.restitut
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -29,6 +28,7 @@ from ..elements.contact_laws import Contact
 from ..elements.firing import SCENE_DIRECTORY
 from ..elements.table import suggestion
 from ..errors import SceneError
+from ..inputs import parse_toml, read_text_file
 from .container import Conventions, Scene
 
 #: The scene format versions this library reads; it writes the last.
@@ -150,20 +150,11 @@ def _conventions(content) -> Conventions:
 
 
 def load_scene(path: str | Path) -> Scene:
-    """Read a scene TOML file; raise :class:`SceneError` for unreadable, malformed or invalid files."""
+    """Read a scene TOML file; raise :class:`SceneError` for unreadable, malformed or invalid files (and for a
+    file that is not a regular UTF-8 file of at most 64 MiB, or nests more than 32 deep: :mod:`mbs_models.inputs`)."""
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise SceneError("", f"scene file not found: {path}") from None
-    except IsADirectoryError:
-        raise SceneError("", f"scene path is a directory, not a file: {path}") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise SceneError("", f"cannot read scene file {path}: {exc}") from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise SceneError("", f"malformed TOML in {path}: {exc}") from None
+    text = read_text_file(path, "", "scene file")  # a regular UTF-8 file of at most MAX_INPUT_BYTES
+    data = parse_toml(text, "", str(path))           # nesting bounded before the parser recurses
     token = SCENE_DIRECTORY.set(path.resolve().parent)  # relative file names in the scene: beside it
     try:
         return scene_from_dict(data)

@@ -34,6 +34,7 @@ from ..elements import ELEMENT_TABLES, Table
 from ..elements.contact_laws import CONTACT_LAWS, LAW_FIELDS
 from ..elements.table import rekey, suggestion
 from ..errors import SceneError
+from ..inputs import check_toml_nesting
 from .container import Conventions, Scene
 
 _SINGLE_TABLES = [name for name, cls in ELEMENT_TABLES.items() if not cls.MANY]
@@ -227,6 +228,7 @@ def parse_value(text: str, key: str = "") -> Any:
     stripped = text.strip()
     if not stripped:
         raise SceneError(key, "no value given")
+    check_toml_nesting(stripped, key, "the value")  # before the parser recurses once per level
     try:
         value = tomllib.loads(f"value = {stripped}")["value"]
     except tomllib.TOMLDecodeError:

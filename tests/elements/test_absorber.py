@@ -144,7 +144,7 @@ BAD_ABSORBERS = [
     ("contact-not-a-table", "absorber.1.contact", 3.0, "absorber.1.contact", "must be a table"),
     ("missing-gap", "absorber.0.contact.gap", "<delete>", "absorber.0.contact.gap", "missing"),
     ("negative-gap", "absorber.0.contact.gap", -0.01, "absorber.0.contact.gap", ">= 0 m"),
-    ("duplicate-names", "absorber.1.name", "front", "absorber.name", "names two absorbers"),
+    ("duplicate-names", "absorber.1.name", "front", "absorber.1.name", "names two absorbers"),
     ("bad-name", "absorber.1.name", "rear wheel", "absorber.1.name", "identifier"),
     ("unknown-key", "absorber.0.masss", 1.0, "absorber.0.masss", "did you mean 'mass'"),
 ]
@@ -166,3 +166,10 @@ def test_version_1_has_one_absorber_and_a_top_level_contact(bad_input, v1_mappin
     single["absorber"][0] = {k: v for k, v in single["absorber"][0].items() if k != "contact"}
     single["contact"] = dict(v1_mapping["contact"])  # a version-1 pair inside a version-2 file: one absorber
     assert scene_from_dict(single).absorber.contact.gap == 0.0
+
+
+def test_an_initial_interference_beyond_double_precision_is_refused(bad_input, v2_mapping):
+    """literal_gap_sign: p(0) = gap.  k gap^n = 2.1e8 x (1e300)^1.3 overflows: refused naming the gap."""
+    mapping = dict(v2_mapping, conventions={"literal_gap_sign": True})
+    mapping["absorber"][0]["contact"] = dict(mapping["absorber"][0]["contact"], gap=1e300)
+    bad_input(mapping, "absorber.0.contact.gap", "initial interference's force")

@@ -270,6 +270,21 @@ BAD_CONTACTS = [
     ("zero-stiffness", "absorber.0.contact.stiffness", 0.0, "absorber.0.contact.stiffness", "> 0"),
     ("unknown-key", "absorber.1.contact.restitusion", 0.5, "absorber.1.contact.restitusion",
      "did you mean 'restitution'"),
+    # beyond double precision (DESIGN.md, "Bad input beyond the ranges"), flores: chi = 8 (1 - e) / (5 e)
+    ("chi-overflows", "absorber.1.contact.restitution", 5e-324, "absorber.1.contact.restitution",
+     "restitution factor chi = inf"),
+    # chi = 1.6e306 is finite, chi / 1e-3 m/s = 1.6e309 is not
+    ("chi-over-floor-overflows", "absorber.1.contact.restitution", 1e-306, "absorber.1.contact.restitution",
+     "chi / minimum_impact_velocity"),
+    # chi = 1.6 at e = 0.5: 1.6 / 1e-320 overflows
+    ("floor-underflows", "absorber.1.contact.minimum_impact_velocity", 1e-320,
+     "absorber.1.contact.minimum_impact_velocity", "chi / minimum_impact_velocity"),
+    ("exact-restitution-bracket", "absorber.1.contact", {"gap": 0.02, "law": "exact-restitution", "stiffness": 2.1e8,
+                                                        "exponent": 1.3, "restitution": 5e-324},
+     "absorber.1.contact.restitution", "1 / restitution"),
+    ("kelvin-voigt-relaxation-time", "absorber.1.contact", {"gap": 0.02, "law": "kelvin-voigt",
+                                                           "stiffness": 5e-324, "damping": 1e3},
+     "absorber.1.contact.stiffness", "relaxation time c / k"),
 ]
 
 

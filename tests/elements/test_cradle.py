@@ -68,6 +68,10 @@ BAD_CRADLE = [
     ("unknown-key", "cradle.friction_coeficient", 0.05, "cradle.friction_coeficient",
      "did you mean 'friction_coefficient'"),
     ("not-a-table", "cradle", 30.0, "cradle", "must be a table"),
+    # beyond double precision (DESIGN.md, "Bad input beyond the ranges"): M g sin = 5600 x 1e305 x 0.5 = 2.8e308 N
+    ("weight-overflows", "cradle.gravity", 1e305, "cradle.gravity", "weight along the recoil axis"),
+    # mu N / v_reg = 0.05 x 5600 x 9.81 x cos 30 / 5e-324 = inf
+    ("slope-overflows", "cradle.friction_velocity", 5e-324, "cradle.friction_velocity", "slope mu N / friction_velocity"),
 ]
 
 

@@ -153,7 +153,93 @@ def test_a_bad_pulse_file_is_one_line(tmp_path, capsys, content, text):
     assert len(err) == 1 and "firing.pulse.file" in err[0] and text in err[0]
     (tmp_path / "breech.csv").unlink()
     assert main(["run", str(tmp_path / "scene.toml")]) == 2
-    assert "cannot read the pulse file" in capsys.readouterr().err
+    assert "pulse file not found" in capsys.readouterr().err
+
+
+def _scene_with_pulse_file(tmp_path, name: str):
+    mapping = pulse_mapping()
+    mapping["firing"]["pulse"] = {"file": name}
+    from mbs_models.scene.io import mapping_to_toml
+    (tmp_path / "scene.toml").write_text(mapping_to_toml(mapping))
+    return tmp_path / "scene.toml"
+
+
+def _one_line_naming_the_file(capsys, path, text: str) -> None:
+    assert main(["run", str(path)]) == 2
+    captured = capsys.readouterr()
+    lines = captured.err.strip().splitlines()
+    assert len(lines) == 1 and "firing.pulse.file" in lines[0] and text in lines[0], captured.err
+    assert "Traceback" not in captured.err and captured.out == ""
+
+
+@pytest.mark.skipif(not __import__("os").path.exists("/dev/zero"), reason="needs /dev/zero")
+def test_a_pulse_file_that_never_ends_or_is_no_file_is_refused_at_once(tmp_path, capsys):
+    """/dev/zero (read without a limit: a MemoryError), a directory and a FIFO (reading it waits for a writer)
+    are refused before a byte is read, in one line naming firing.pulse.file."""
+    import os
+    _one_line_naming_the_file(capsys, _scene_with_pulse_file(tmp_path, "/dev/zero"), "not a regular file")
+    (tmp_path / "dir.csv").mkdir()
+    _one_line_naming_the_file(capsys, _scene_with_pulse_file(tmp_path, "dir.csv"), "is a directory")
+    os.mkfifo(tmp_path / "pipe.csv")
+    _one_line_naming_the_file(capsys, _scene_with_pulse_file(tmp_path, "pipe.csv"), "not a regular file")
+
+
+@pytest.mark.parametrize("content, text", [(b"time,force\n0.0,1.0\n\x00\x01,2\n", "a binary file"),
+                                           ("time,force # \u00e9\n0.0,1.0\n".encode("latin-1"), "not UTF-8"),
+                                           (b"time,force\n" + b"1" * 200_000 + b"\n", "not a CSV table")])
+def test_a_binary_non_utf8_or_unparsable_pulse_file_is_one_line(tmp_path, capsys, content, text):
+    """A NUL byte, Latin-1 text, a field beyond the csv module's limit (128 KiB): one line, no traceback."""
+    (tmp_path / "breech.csv").write_bytes(content)
+    _one_line_naming_the_file(capsys, _scene_with_pulse_file(tmp_path, "breech.csv"), text)
+
+
+def test_a_pulse_file_beyond_the_input_limit_is_refused(tmp_path, monkeypatch):
+    """Read with a limit (``MAX_INPUT_BYTES``, 64 MiB; a smaller one here): a longer file is refused, not read."""
+    from mbs_models import inputs
+    monkeypatch.setattr(inputs, "MAX_INPUT_BYTES", 1000)
+    rows = "".join(f"{i * 1e-4:.4f},{1e6:.1f}\n" for i in range(100))  # about 1.5 kB
+    (tmp_path / "long.csv").write_text("time,force\n" + rows)
+    with pytest.raises(SceneError, match="larger than 1000 bytes") as info:
+        load_scene(_scene_with_pulse_file(tmp_path, "long.csv"))
+    assert info.value.key == "firing.pulse.file"
+
+
+#: Magnitudes in range whose derived quantities double precision cannot hold (DESIGN.md, "Bad input beyond the
+#: ranges"): (dotted path, value, the key named, the quantity named).  Each derived by hand: the products below
+#: overflow past 1.8e308 or underflow below 4.9e-324.
+BEYOND_DOUBLE = [
+    # impulse 1e308 (0.5 + 1 + 0.5) = 2e308 N s
+    ("firing.pulse", {"times": [0.0, 1.0, 2.0, 3.0], "forces": [0.0, 1e308, 1e308, 0.0]}, "firing.pulse.forces",
+     "impulse"),
+    # impulse 0.5 x 1e-320 x 1e-10 rounds to 0
+    ("firing.pulse", {"times": [0.0, 1e-10, 2e-10], "forces": [0.0, 1e-320, 0.0]}, "firing.pulse.forces", "impulse"),
+    # I / impulse = 3869 / (1e-310 x 1e-3) = 3.9e316
+    ("firing.pulse", {"times": [0.0, 1e-3, 2e-3], "forces": [0.0, 1e-310, 0.0], "scale_to_momentum": True},
+     "firing.pulse.forces", "scale of the pulse"),
+    # I = 1e300 x 1e10 = 1e310 (the projectile mass farther from 1 than the velocity)
+    ("firing.projectile_mass", 1e300, "firing.projectile_mass", None),
+    # I = 1e-300 x 1e-30 = 1e-330 rounds to 0
+    ("firing.projectile_mass", 1e-300, "firing.projectile_mass", None),
+    # shots x interval = 1000 x 1e306
+    ("burst", {"shots": 1000, "interval": 1e306}, "burst.interval", "shots x interval"),
+]
+
+
+@pytest.mark.parametrize("path, value, key, quantity", BEYOND_DOUBLE)
+def test_a_magnitude_beyond_double_precision_is_one_line_naming_the_key(bad_input, changed, path, value, key,
+                                                                        quantity):
+    mapping = changed(pulse_mapping(), path, value)
+    if path == "firing.projectile_mass":  # the velocity that takes the momentum beyond
+        mapping = changed(mapping, "firing.muzzle_velocity", 1e10 if value > 1 else 1e-30)
+        quantity = "firing momentum"
+    bad_input(mapping, key, quantity)
+
+
+def test_magnitudes_just_within_double_precision_load():
+    """The same quantities just inside: an impulse of 1.5e308 N s, a momentum of 1e300 x 1e8 = 1e308 kg m/s."""
+    Pulse(times=(0.0, 1.0, 2.0), forces=(0.0, 1.5e308, 0.0))
+    Firing(projectile_mass=1e300, muzzle_velocity=1e8)
+    Burst(shots=1000, interval=1e305)
 
 
 def test_scenes_round_trip_through_toml(tmp_path):

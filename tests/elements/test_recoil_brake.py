@@ -153,6 +153,36 @@ BAD_BRAKES = [
 ]
 
 
+#: Values in range whose law double precision cannot hold (DESIGN.md, "Bad input beyond the ranges"): the brake's
+#: A^3, Cd^2, rho A^3 / (2 Cd^2) and, at the smallest area a = 5e-5 m^2 (a^2 = 2.5e-9), rho A^3 / (2 Cd^2 a^2).
+BAD_BRAKES += [
+    ("cube-overflows", "recoil_brake.piston_area", 1e103, "recoil_brake.piston_area", "A^3 = inf"),  # 1e309
+    ("cube-underflows", "recoil_brake.piston_area", 1e-110, "recoil_brake.piston_area", "A^3 = 0"),  # 1e-330
+    ("cd-square-underflows", "recoil_brake.discharge_coefficient", 1e-170, "recoil_brake.discharge_coefficient",
+     "Cd^2 = 0"),
+    # 870 x 1.728e-6 / (2 x 1e-320) = 7.5e316
+    ("coefficient-overflows", "recoil_brake.discharge_coefficient", 1e-160, "recoil_brake.discharge_coefficient",
+     "rho A^3 / (2 Cd^2) = inf"),
+    ("area-square-underflows", "recoil_brake.orifice_area", [[0.0, 3e-4], [0.3, 1e-170]], "recoil_brake.orifice_area",
+     "a^2 = 0"),
+    # 1e306 x 1.728e-6 / 0.98 / 2.5e-9 = 7.1e308
+    ("coefficient-at-smallest-area", "recoil_brake.fluid_density", 1e306, "recoil_brake.fluid_density",
+     "at the smallest area"),
+]
+
+
+def test_a_brake_force_beyond_double_precision_at_the_free_recoil_speed_is_refused(v2_mapping):
+    """rho chosen so that K(a_min) = rho A^3 / (2 Cd^2 a_min^2) is 1e308 kg/m^3: at the paper's v0 = 0.69 m/s the
+    force K v0^2 = 4.8e307 N is finite; at v0 = 6.86 x 1500 / 5600 = 1.84 m/s it is 3.4e308: refused."""
+    rho = 2.0 * 0.7 ** 2 * 5e-5 ** 2 / 0.012 ** 3 * 1e308
+    mapping = {**v2_mapping, "recoil_brake": dict(BRAKE_TABLE, fluid_density=rho)}
+    scene_from_dict(mapping)
+    mapping["firing"] = dict(mapping["firing"], muzzle_velocity=1500.0)
+    with pytest.raises(SceneError, match="force at the barrel's free-recoil speed") as info:
+        scene_from_dict(mapping)
+    assert info.value.key == "recoil_brake.fluid_density" and "\n" not in str(info.value)
+
+
 @pytest.mark.parametrize("path, value, key, text", [c[1:] for c in BAD_BRAKES], ids=[c[0] for c in BAD_BRAKES])
 def test_bad_brake_tables_are_one_line_errors_naming_the_key(bad_input, v2_mapping, changed, path, value, key, text):
     """API (scene_from_dict) and ``recoil run``: SceneError naming the key, one line on stderr, exit 2."""

@@ -178,12 +178,39 @@ BAD = [
     ("not-a-table", "recuperator", 3.0, "recuperator", "must be a table"),
     # holding in battery: a preload with nothing to rest on
     ("no-battery-stop", "battery_stop", "<delete>", "battery_stop", "needs a [battery_stop] to rest on"),
+    # beyond double precision (DESIGN.md, "Bad input beyond the ranges"): 1.3 x 1e6 x 0.002^2 / 1e-320 overflows
+    ("stiffness-overflows", "recuperator.gas_volume", 1e-320, "recuperator.gas_volume", "stiffness at battery"),
+    # p0 V0 = 1e-94 J against E0 = 1337 J: r^(n-1) = 1 + 0.3 E0 / (p0 V0) = 4e96, F = p0 A r^1.3/0.3 ~ 1e422 N
+    ("force-at-stroke-overflows", "recuperator.gas_volume", 1e-100, "recuperator.gas_volume",
+     "force at the stroke U^-1(E)"),
 ]
 
 
 @pytest.mark.parametrize("path, value, key, text", [c[1:] for c in BAD], ids=[c[0] for c in BAD])
 def test_bad_recuperator_tables_are_one_line_errors_naming_the_key(bad_input, changed, path, value, key, text):
     bad_input(changed(example_mapping(), path, value), key, text)
+
+
+def test_a_preload_that_underflows_is_refused(bad_input, changed):
+    """p0 A = 1e-320 x 1e-10 rounds to 0 N: not a preload double precision holds."""
+    mapping = changed(changed(example_mapping(), "recuperator.initial_pressure", 1e-320), "recuperator.piston_area",
+                      1e-10)
+    bad_input(mapping, "recuperator.initial_pressure", "the preload p0 A = 0 N")
+
+
+def test_the_equilibrium_in_battery_is_found_down_to_a_gas_volume_of_1e_300():
+    """With V0 / A ~ 1e-298 m the gas spring's force falls from the preload within 1e-298 m of battery: Brent's
+    method brackets the root in [-1e-9, 0] m and needs more than the 500 iterations it was once given.  A shot
+    of v0 = 1e-150 m/s (E0 = 2.8e-297 J against p0 V0 = 1e-294 J: a finite force at its stroke) is a valid scene;
+    the equilibrium balances the stop's force against the gas spring's at the root."""
+    gas = Recuperator(initial_pressure=1.0e6, piston_area=0.002, gas_volume=1e-300, polytropic_exponent=1.3)
+    scene = EXAMPLE.with_changes(recuperator=gas, firing=None, barrel=Barrel(5600.0, initial_velocity=1e-150))
+    mechanism = Mechanism(scene)
+    x0 = held_position(scene, mechanism.connectors)
+    stop = mechanism.connector["battery_stop"]
+    spring = mechanism.connector["recuperator"]
+    assert -1e-9 < x0 < 0.0
+    assert math.isclose(stop.python_force(-x0, 0.0), spring.python_force(x0, 0.0), rel_tol=1e-6)
 
 
 def test_the_recuperator_needs_a_version_2_scene(bad_input, v1_mapping):
@@ -212,7 +239,7 @@ def test_a_preload_that_cannot_return_the_barrel_against_gravity_and_friction_is
     resisting = 5600.0 * G * (math.sin(math.radians(30.0)) + 0.1 * math.cos(math.radians(30.0)))  # 32 222 N
     cradle = SimpleNamespace(elevation=30.0, gravity=G, friction_coefficient=0.1)
     scene = SimpleNamespace(barrel=Barrel(5600.0, initial_velocity=0.0), battery_stop=EXAMPLE.battery_stop,
-                            recoil_stop=None, cradle=cradle)
+                            recoil_stop=None, cradle=cradle, initial_velocity=0.0)
     with pytest.raises(SceneError) as info:
         GAS.check_in_scene(scene, "recuperator")
     assert info.value.key == "recuperator.initial_pressure"

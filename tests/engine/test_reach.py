@@ -4,14 +4,16 @@ closes is never reported (the bound is a proof, not an estimate)."""
 from __future__ import annotations
 
 import math
+import warnings
 
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from mbs_models import load_scene, model_i, model_ii, simplified_model, simulate
-from mbs_models.engine.final_metrics import ENERGY_SLACK
-from mbs_models.engine.reach import contacts_out_of_reach
+from mbs_models.engine.final_metrics import ENERGY_SLACK, EnergyBounds
+from mbs_models.engine.mechanism import Mechanism
+from mbs_models.engine.reach import contact_reach_bounds, contacts_out_of_reach
 from mbs_models.scenes import list_scenes, scene_path
 
 
@@ -102,3 +104,17 @@ def test_a_reported_contact_never_closes(mass, fraction, mount, damping):
     reported = contacts_out_of_reach(scene)
     peak = simulate(scene, 2.0, "draft").peak_contact_force
     assert not (reported and peak > 0.0), (reported, peak)
+
+
+def test_a_spring_too_weak_for_double_precision_gives_no_bound_and_no_warning():
+    """k = 5e-324 N/m: the stroke bound sqrt(2 E / k) overflows (2 / k is beyond 1.8e308), so the spring bounds
+    nothing -- an infinite reach, nothing reported -- without a numpy overflow warning."""
+    scene = model_ii(1000.0, 0.0).with_changes(**{"recoil_spring.stiffness": 5e-324})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        assert contact_reach_bounds(scene) == [(math.inf, True)]
+        assert contacts_out_of_reach(scene) == []
+        mechanism = Mechanism(scene)
+        bounds = EnergyBounds(mechanism)
+        assert bounds.contact_reach(0, bounds.energy(mechanism.initial_positions(),
+                                                     mechanism.initial_velocities())) == math.inf

@@ -26,3 +26,32 @@ def test_an_initial_interference_approached_at_t0_stays_an_impact():
     assert static * law.damping_factor * v0 > 10 * THRESHOLD
     first = result.impacts[0]
     assert first.start == 0.0 and first.peak_force - static > 10 * THRESHOLD
+
+
+def test_samples_whose_energies_overflow_are_a_simulation_error_without_warnings():
+    """Finite samples of a diverged solve: the barrel at 1e200 m/s (x = v t).  Its kinetic energy
+    M v^2 / 2 = 2800 x 1e400 J is beyond double precision: a SimulationError naming it, no numpy warning, never an
+    inf in the results.  At 1e100 m/s (2.8e203 J) the same samples are analysed."""
+    import warnings
+
+    import numpy as np
+    import pytest
+
+    from mbs_models import SimulationError, simplified_model
+    from mbs_models.engine.mechanism import Mechanism
+    from mbs_models.results.postprocess import analyse
+    from mbs_models.results.samples import Samples
+
+    mechanism = Mechanism(simplified_model())
+    t = np.array([0.0, 1e-3, 2e-3])
+
+    def samples(speed: float) -> Samples:
+        return Samples(t, {"barrel": speed * t}, {"barrel": np.full(3, speed)}, {"barrel": np.zeros(3)})
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        with pytest.raises(SimulationError, match="kinetic energy of barrel is beyond double precision") as info:
+            analyse(mechanism, samples(1e200), THRESHOLD)
+        assert "\n" not in str(info.value)
+        metrics = analyse(mechanism, samples(1e100), THRESHOLD)
+    assert np.isclose(metrics.energies.kinetic["barrel"][-1], 2.8e203, rtol=1e-15, atol=0.0)

@@ -169,3 +169,10 @@ def test_spec_size_is_the_number_of_values(spec):
 
 def test_spec_size_of_a_range_makes_no_values():
     assert spec_size("0:1:1000000000000") == 10**12   # 10^12 values would be 8 TB: the COUNT is read, not made
+
+
+def test_a_value_nested_1000_deep_is_one_scene_error_naming_the_key():
+    """``--set KEY=[[[...]]]``: the TOML parser recursed once per level (a RecursionError near 1000)."""
+    with pytest.raises(SceneError, match="nested more than 32 deep") as info:
+        parse_value("[" * 1000 + "]" * 1000, "contact.gap")
+    assert info.value.key == "contact.gap"

@@ -13,6 +13,7 @@ All are derived in their docstrings and used by the tests to check :func:`valida
 from __future__ import annotations
 
 import math
+import sys
 
 from scipy.optimize import brentq
 
@@ -116,8 +117,13 @@ def _free_restitution(u: float) -> float:
     if 0 < u < 1:   # z = -e u in (-u, 0): g(-u) > g(u) for 0 < u < 1
         z = brentq(lambda z: _g(z) - target, -u, 0.0, xtol=1e-300, rtol=8.9e-16, maxiter=500)
     elif u >= 1:    # z = -1 + exp(L) close to -1: solve for L = ln(1 + z) < 0, e^L - 1 - L = g(u)
+        def f(L: float) -> float:
+            return math.expm1(L) - L - target
+
         lo = -(target + 2.0)
-        L = brentq(lambda L: math.expm1(L) - L - target, lo, 0.0, xtol=1e-300, rtol=8.9e-16, maxiter=500)
+        if not f(lo) > 0.0:  # g(u) >= 2^53: the 2 is lost to round-off; the root is near -(g(u) + 1)
+            lo = max(-2.0 * (target + 1.0), -sys.float_info.max)
+        L = brentq(f, lo, 0.0, xtol=1e-300, rtol=8.9e-16, maxiter=500)
         z = math.expm1(L)
     else:           # literal sign, -1 < u < 0: z in (0, inf), g rising there
         hi = -u
@@ -153,7 +159,10 @@ def exact_restitution_factor(restitution: float) -> float:
     e = _check_restitution(restitution)
     if e == 1.0:
         return 0.0
-    return brentq(lambda chi: _free_restitution(chi) - e, 1e-300, 1.0 / e, xtol=1e-300, rtol=8.9e-16, maxiter=500)
+    high = 1.0 / e
+    if not _free_restitution(high) < e:  # e(1/e) < e holds exactly, not always after round-off (e ~ 1e-305)
+        high = min(2.0 / e, sys.float_info.max)
+    return brentq(lambda chi: _free_restitution(chi) - e, 1e-300, high, xtol=1e-300, rtol=8.9e-16, maxiter=500)
 
 
 def restitution_factor(law: str, restitution: float) -> float:

@@ -30,7 +30,7 @@ from .assembly import build_model
 from .dense import DenseSolution
 from .finality import METRICS, Finality, check_names
 from .result import STOP_END_TIME, STOP_METRICS_FINAL, STOP_NO_BOUND, ReferenceImpact, ReferenceResult, ReferenceSegment
-from .switching import Restart, missed_crossing
+from .switching import NonFiniteEvent, Restart, missed_crossing
 
 __all__ = ["METHODS", "ReferenceSolveError", "solve_reference", "ReferenceResult", "ReferenceImpact",
            "ReferenceSegment"]
@@ -53,7 +53,10 @@ def _integrate(rhs, t0: float, t1: float, y0, options: dict, mode):
     # rejected trial steps of an explicit method on a stiff contact may overflow; accepted states
     # are checked for finiteness below, so the floating-point warnings are noise, not results
     with np.errstate(over="ignore", invalid="ignore"):
-        sol = solve_ivp(rhs, (t0, t1), y0, dense_output=True, **options)
+        try:
+            sol = solve_ivp(rhs, (t0, t1), y0, dense_output=True, **options)
+        except NonFiniteEvent as exc:
+            raise ReferenceSolveError(f"non-finite state after t = {t0:.9g} s in {mode}: {exc}") from None
     if sol.status < 0:
         raise ReferenceSolveError(f"solve_ivp ({options['method']}) failed at t = {t0:.9g} s in {mode}: "
                                   f"{sol.message}")

@@ -33,6 +33,11 @@ def heading(g, dg, ddg=0.0, tol=TOL_POS) -> bool:
     return ddg > 0
 
 
+class NonFiniteEvent(FloatingPointError):
+    """A switching function evaluated to NaN inside ``solve_ivp``'s event location: the solve fails
+    (:class:`~validation.reference.solver.ReferenceSolveError`), no root is sought in it."""
+
+
 def sided(g, t_start: float, positive: bool, window: float = 0.0):
     """Terminal event from ``g(t, y)`` watching the crossing that leaves the ``positive`` side.
 
@@ -49,6 +54,8 @@ def sided(g, t_start: float, positive: bool, window: float = 0.0):
 
     def fun(t, y):
         value = g(t, y)
+        if value != value:  # NaN: the dense output left the finite numbers (a diverging solution)
+            raise NonFiniteEvent(f"a switching function is NaN at t = {t:.9g} s")
         if sign * value > 0:
             seen[0] = True
         elif t - t_start <= window or (value == 0 and not seen[0]):
@@ -64,7 +71,8 @@ def rearm_window(value: float, rate: float | None, noise: float, positive: bool)
     """Time (s) for a function sitting on its surface (``|value| <= noise``) to clear 100 noise levels."""
     if abs(value) > noise or rate is None or not (rate > 0) == positive or rate == 0:
         return 0.0
-    return min(100.0 * noise / abs(rate), 1e-8)
+    with np.errstate(over="ignore"):  # a rate too small for double precision: the window's cap
+        return min(100.0 * noise / abs(rate), 1e-8)
 
 
 def missed_crossing(dense, funcs, names, t0: float, t1: float):

@@ -151,10 +151,12 @@ class ContactConnector(Connector):
         return 1.0 + factor * rate
 
     def surface_rate(self, rate, acceleration, factor):
-        """Its time derivative: ``a p''`` or ``p' + (c/k) p''``."""
-        if self.law.kelvin_voigt:
-            return rate + self.law.damping / self.law.stiffness * acceleration
-        return factor * acceleration
+        """Its time derivative: ``a p''`` or ``p' + (c/k) p''`` (only its sign is read: an extreme factor's product
+        may overflow to +-inf, without a warning)."""
+        with np.errstate(over="ignore"):
+            if self.law.kelvin_voigt:
+                return rate + self.law.damping / self.law.stiffness * acceleration
+            return factor * acceleration
 
     def equations(self, state: ContactMode) -> Equations | None:
         """The force of ``state``; the dissipated power ``(F - k p^n) p'`` (``k p^n`` continued oddly to

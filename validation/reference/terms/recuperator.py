@@ -63,20 +63,29 @@ class GasSpring(Connector):
     def _ratio(self, d):
         return self.volume / (self.volume - self.area * d)
 
+    def _ratio_power(self, d: float, exponent: float) -> float:
+        """``r^exponent`` (d a float): inf where it overflows near ``V0 / A`` (Python's float power raises)."""
+        try:
+            return self._ratio(d) ** exponent
+        except OverflowError:
+            return math.inf
+
     def force_rate(self, state, d, rate, acceleration):
         """``dF/dt = n p0 A^2 / V0 r^(n+1) d'`` (N/s)."""
-        return self.exponent * self.preload * self.area / self.volume * self._ratio(d) ** (self.exponent + 1.0) * rate
+        return self.exponent * self.preload * self.area / self.volume * self._ratio_power(d, self.exponent + 1.0) * rate
 
     def stored_energy(self, d):
-        """``U(d)`` (J; module docstring)."""
-        log_r = np.log1p(self.area * d / (self.volume - self.area * d))
+        """``U(d)`` (J; module docstring).  A gas expanded so far that ``A d / (V0 - A d)`` rounds to -1 has
+        ``ln r = -inf``: U is its limit, ``-p0 V0 / (n - 1)`` (-inf for n = 1), without a warning."""
+        with np.errstate(divide="ignore"):
+            log_r = np.log1p(self.area * d / (self.volume - self.area * d))
         if self.exponent == 1.0:
             return self.pressure * self.volume * log_r
         return self.pressure * self.volume * np.expm1((self.exponent - 1.0) * log_r) / (self.exponent - 1.0)
 
     def static_force(self, d: float) -> float:
         """``F(d)`` (N): the law has no rate."""
-        return self.preload * self._ratio(d) ** self.exponent
+        return self.preload * self._ratio_power(d, self.exponent)
 
     def force_bound(self, d_bound: float, rate_bound: float, penetration_bound: float) -> float:
         """``F(d_bound)`` (N); inf at or beyond ``V0 / A``."""
@@ -107,7 +116,11 @@ def hold_in_battery(builder) -> None:
         upper, lower = lower, 2.0 * lower
         if lower < -1e3:
             raise ReferenceModelError("recuperator: nothing holds the barrel against the preload within 1 km")
-    x0 = brentq(net_force, lower, upper, xtol=1e-300, rtol=4.0 * np.finfo(float).eps, maxiter=500)
+    # bisecting 1 km down to xtol = 1e-300 m takes about 1010 halvings: Brent's method at most a few times that
+    x0, status = brentq(net_force, lower, upper, xtol=1e-300, rtol=4.0 * np.finfo(float).eps, maxiter=4000,
+                        full_output=True, disp=False)
+    if not status.converged:
+        raise ReferenceModelError(f"recuperator: the static equilibrium in battery is not resolved ({status.flag})")
     grounded = {c.b for c in builder.connectors if c.a == GROUND} | {c.a for c in builder.connectors if c.b == GROUND}
     for body in builder.bodies:
         if body.name == BARREL or body.name not in grounded:
