@@ -15,6 +15,26 @@ import tomllib
 from mbs_models.scenes import scene_path
 
 
+def _import_every_project_module() -> None:
+    """Import every module of ``mbs_models`` and ``validation`` before any test runs.
+
+    Hypothesis draws some values from the literals of the local modules imported so far
+    (``hypothesis.internal.conjecture.providers._get_local_constants``): without this, a derandomized
+    property test draws other examples when run alone than in the whole suite (``test_properties.py``
+    alone once drew a chattering 1-kg absorber the suite never drew)."""
+    import importlib
+    import pkgutil
+
+    for name in ("mbs_models", "validation"):
+        package = importlib.import_module(name)
+        for module in pkgutil.walk_packages(package.__path__, f"{name}."):
+            if not module.name.endswith("__main__"):
+                importlib.import_module(module.name)
+
+
+_import_every_project_module()
+
+
 def paper_scene_dict() -> dict:
     """Model (ii), m = 1000 kg, gap 0: the shipped version-1 file as a TOML mapping."""
     return tomllib.loads(scene_path("model_ii").read_text())

@@ -26,6 +26,9 @@ from mbs_models import Scene, model_i, model_ii, simulate
 from validation.studies.guarantee import (TOLERANCES, errors_against_reference, physical_violations, reference_for,
                                            violations)
 
+# random gaps may lie beyond the free-recoil travel (the warning is tested elsewhere)
+pytestmark = pytest.mark.filterwarnings("ignore:absorber.*beyond the barrel's free-recoil travel:mbs_models.errors.UnitWarning")
+
 #: Simulated time per example, s: covers the first impacts and the barrel's maximum.
 END_TIME = 1.0
 FAST_EXAMPLES = 25
@@ -101,9 +104,16 @@ LIGHT_UNDAMPED = model_ii(1.0, 0.0).with_changes(**{
     "recoil_damper.recoil": 0.0, "recoil_damper.counter_recoil": 0.0, "firing.muzzle_velocity": 100.0,
     "contact.stiffness": 1e8, "contact.exponent": 1.0, "contact.damping_factor": 0.0, "absorber.damping": 0.0})
 
+#: an undamped 1-kg absorber chattering 351 times in 1 s, the last impact cut off by the window's end on its
+#: rise (its force there is no peak: compared on its start only)
+CHATTERING = model_ii(1.0, 0.0).with_changes(**{
+    "recoil_damper.recoil": 0.0, "recoil_damper.counter_recoil": 0.0, "firing.muzzle_velocity": 100.0,
+    "contact.stiffness": 1e9, "contact.exponent": 1.5, "contact.damping_factor": 0.0, "absorber.damping": 0.0})
+
 
 @FAST
 @given(scene=scenes())
+@example(scene=CHATTERING)
 @example(scene=BOUNCING_TO_REST)
 @example(scene=LIGHT_UNDAMPED)
 def test_random_scenes_standard(scene):
@@ -135,3 +145,28 @@ REGRESSIONS = {"bouncing-to-rest": (BOUNCING_TO_REST, ("draft", "standard")),
                                             for accuracy in presets])
 def test_regression_scenes_every_preset(name, accuracy):
     check_scene(REGRESSIONS[name][0], accuracy)
+
+
+#: Found by hypothesis (only when the set of imported modules changed its draws, see conftest.py): an undamped
+#: 1-kg absorber on a stiff quadratic contact chatters ~30 times in 1 s with penetrations of ~0.4 mm. Its force
+#: F = k d^2 has the relative error 2 (position error) / d, and the positions' error is the preset's absolute
+#: one: at `standard` the peak contact force is off by 3.5e-5 (the guarantee for peak forces: 2e-5; the
+#: per-impact peak bound 1e-4 holds), at `draft` two impacts within a few N of the threshold count on one side
+#: only. A stated exception (README, "What is guaranteed"), pinned here so it cannot grow unnoticed.
+STIFF_CHATTER = CHATTERING.with_changes(**{"contact.stiffness": 1e10, "contact.exponent": 2.0})
+
+
+def test_light_chattering_absorber_is_the_stated_exception():
+    result = simulate(STIFF_CHATTER, END_TIME, "standard")
+    errors = errors_against_reference(result, reference_for(STIFF_CHATTER, END_TIME, accuracy="standard"))
+    tolerance = TOLERANCES["standard"]
+    assert errors["F"] <= tolerance["impact_peak"] and errors["peaks"] <= tolerance["impact_peak"], errors
+    assert violations({**errors, "F": 0.0}, "standard") == [], errors  # everything else within the guarantee
+    assert physical_violations(result, tolerance["energy"]) == []
+
+
+@pytest.mark.slow
+def test_light_chattering_absorber_at_reference_is_within_the_guarantee():
+    result = simulate(STIFF_CHATTER, END_TIME, "reference")
+    errors = errors_against_reference(result, reference_for(STIFF_CHATTER, END_TIME, accuracy="reference"))
+    assert violations(errors, "reference") == [], errors

@@ -82,7 +82,11 @@ def merge_close(episodes, gap: float) -> list[tuple[float, float, float]]:
 def _impact_errors(ours_all, theirs_all, threshold: float, window: float, merge_gap: float,
                    initial_rest_force: float = 0.0) -> tuple[int, float, float]:
     """(impacts on one side only, largest start/end error s, largest relative peak error) of one contact.
-    ``initial_rest_force`` (N): the force at rest an episode going on at t = 0 rises from (0 for the others)."""
+    ``initial_rest_force`` (N): the force at rest an episode going on at t = 0 rises from (0 for the others).
+
+    An impact still going on at the end of the window is compared on its start only: its "peak" is then the
+    force at the window's end, on the rise, whose error is the start time's error times the force's slope
+    (a 1-kg absorber chattering 351 times in 1 s: 8.4 us late at standard, 2.4 % of that force)."""
     band = THRESHOLD_BAND * threshold
 
     def clear(start, peak):
@@ -95,7 +99,8 @@ def _impact_errors(ours_all, theirs_all, threshold: float, window: float, merge_
     if not mismatch:
         for (start, end, peak), (ref_start, ref_end, ref_peak) in zip(ours, theirs):
             time_error = max(time_error, abs(start - ref_start), abs(min(end, window) - ref_end))
-            peak_error = max(peak_error, abs(peak - ref_peak) / ref_peak)
+            if ref_end < window:  # an impact cut off by the window's end has no peak of its own (see above)
+                peak_error = max(peak_error, abs(peak - ref_peak) / ref_peak)
     return mismatch, time_error, peak_error
 
 
