@@ -171,18 +171,23 @@ def all_cases(values) -> list[tuple[str, str, object]]:
             for value in values]
 
 
-def run_cases(cases, timeout: float, directory: Path, solver: str = "engine") -> list[tuple[tuple, str, str]]:
+def run_cases(cases, timeout: float, directory: Path, solver: str = "engine",
+              worker_script: Path | None = None) -> list[tuple[tuple, str, str]]:
     """``(case, outcome, detail)`` of every case, each run by a worker process (this module as a script, the cases
     in a file in ``directory``); a case that takes longer than ``timeout`` s is stopped (outcome ``timeout``) and
-    a worker started again after it."""
-    cases = [tuple(case) for case in cases]
+    a worker started again after it.  ``worker_script``: another worker script with the same protocol (arguments: the
+    cases' file and the first case's index; one JSON ``[outcome, detail]`` per line on stdout), whose cases are
+    JSON mappings."""
+    cases = [case if isinstance(case, dict) else tuple(case) for case in cases]
     path = directory / "cases.jsonl"
-    path.write_text("".join(json.dumps(list(case)) + "\n" for case in cases))
+    path.write_text("".join(json.dumps(case if isinstance(case, dict) else list(case)) + "\n" for case in cases))
+    arguments = [__file__, str(path)] if worker_script is None else [str(worker_script), str(path)]
+    extra = [solver] if worker_script is None else []
     out: list[tuple[tuple, str, str]] = []
     while len(out) < len(cases):
         errors = directory / "worker.err"
         with open(errors, "wb") as stderr:
-            worker = subprocess.Popen([sys.executable, __file__, str(path), str(len(out)), solver],
+            worker = subprocess.Popen([sys.executable, *arguments, str(len(out)), *extra],
                                       stdout=subprocess.PIPE, stderr=stderr)
         buffer = b""
         while len(out) < len(cases):

@@ -3,7 +3,8 @@
 Exit codes: 0 success; 1 a simulation or check failed, or the Dask cluster of a run did; 2 bad input (one
 line on stderr naming the problem, never a traceback for user mistakes).  A
 :class:`~mbs_models.errors.UnitWarning` (an implausible magnitude, a contact that can never close:
-:mod:`mbs_models.engine.unit_slips`) is one line on stderr, ``recoil: warning: ...``, and the command goes on.
+:mod:`mbs_models.engine.unit_slips`), an ``AccuracyWarning`` or any other of the project's warnings is one line on
+stderr, ``recoil: warning: ...``, and the command goes on.
 """
 
 from __future__ import annotations
@@ -280,12 +281,19 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _one_line_unit_warnings(show_other):
-    """A ``warnings.showwarning`` that prints a :class:`UnitWarning` as one line on stderr (``recoil: warning:
-    KEY = VALUE ...``) and passes every other warning to ``show_other``."""
+def _ours(category) -> bool:
+    """Is ``category`` one of the project's warnings (UnitWarning, AccuracyWarning, UnreadableRowsWarning...)?"""
+    return category.__module__.split(".")[0] in ("mbs_models", "validation")
+
+
+def _one_line_warnings(show_other):
+    """A ``warnings.showwarning`` that prints the project's own warnings (a :class:`UnitWarning`, an
+    ``AccuracyWarning``, unreadable sweep rows) as one line on stderr (``recoil: warning: KEY = VALUE ...``) and
+    passes every other warning to ``show_other``."""
     def show(message, category, filename, lineno, file=None, line=None):
-        if issubclass(category, UnitWarning):
-            print(f"recoil: warning: {message}", file=sys.stderr, flush=True)
+        if _ours(category):
+            text = " ".join(str(message).split())
+            print(f"recoil: warning: {text}", file=sys.stderr, flush=True)
         else:
             show_other(message, category, filename, lineno, file, line)
     return show
@@ -295,7 +303,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``recoil`` console script; returns the exit code."""
     with warnings.catch_warnings():
         warnings.simplefilter("default", UnitWarning)  # each distinct slip once, whatever the user's filters
-        warnings.showwarning = _one_line_unit_warnings(warnings.showwarning)
+        warnings.showwarning = _one_line_warnings(warnings.showwarning)
         return _main(argv)
 
 

@@ -99,7 +99,8 @@ class ContactEstimate:
 
     Attributes
     ----------
-    energy: the initial energy E0 in J (kinetic + elastic contact energy of an initial interference).
+    energy: the initial energy E0 in J (kinetic + elastic contact energy of an initial interference; every
+        stored energy counted by its magnitude: :meth:`~mbs_models.engine.mechanism.Mechanism.energy_scale`).
     reduced_mass: M m / (M + m) in kg.
     impact_speed: approach speed of the estimate in m/s (v0, plus what an initial interference adds).
     penetration: maximum penetration of the undamped impact at ``impact_speed``, in m.
@@ -151,7 +152,10 @@ def estimate_contacts(scene: Scene | Mechanism) -> dict[str, ContactEstimate]:
     """Each contact's penetration, stiffness, frequency and duration (see the module docstring), by name."""
     mechanism = _mechanism(scene)
     out = {}
-    energy = mechanism.initial_energy()
+    # the kinetic energy plus every initial stored energy's magnitude: the initial energy itself unless a
+    # potential is negative at t = 0 (a gas spring's preload holding the barrel into a stop), where it may be
+    # negative while the contact holds an interference's energy
+    energy = mechanism.energy_scale()
     v0 = mechanism.scene.initial_velocity
     firing = getattr(mechanism.scene, "firing", None)
     if firing is not None and firing.pulse is not None:  # the barrel starts at rest: the pulse's momentum

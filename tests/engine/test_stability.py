@@ -348,3 +348,21 @@ def test_stall_that_cannot_be_re_solved_raises_quickly():
         simulate(STALLS["m1-kc1e8-undamped"], 1.0, settings)
     assert time.perf_counter() - start < 60.0  # Exudyn alone never returns: a guard, not a speed test
     assert "\n" not in str(info.value)
+
+
+def test_contact_estimate_with_a_negative_initial_energy():
+    """A gas spring's preload holding the barrel 0.33 m into the battery stop: the initial energy is negative
+    (the gas's potential, zero in battery, is below it) while the stop holds ~110 kJ. The estimate counts every
+    stored energy by its magnitude (found by tests/test_fuzz.py: a complex number to the 1/(n+1))."""
+    from mbs_models import load_scene
+    from mbs_models.engine.mechanism import Mechanism
+    from mbs_models.engine.stability import estimate_contacts
+    from mbs_models.scenes import scene_path
+
+    scene = load_scene(scene_path("recuperator")).with_changes(**{"recuperator.initial_pressure": 4.8e8})
+    mechanism = Mechanism(scene)
+    assert mechanism.initial_energy() < 0.0
+    [estimate] = estimate_contacts(mechanism).values()
+    assert estimate.energy == mechanism.energy_scale() > 0.0
+    assert 0.0 < estimate.penetration <= estimate.max_penetration < math.inf
+    assert math.isfinite(estimate.duration) and estimate.duration > 0.0
