@@ -189,7 +189,7 @@ class LawFields:
     @classmethod
     def from_mapping(cls, data, key, version):
         law = data.get("law", "hunt-crossley") if isinstance(data, dict) else "hunt-crossley"
-        if version < 2 and law != "hunt-crossley" and law in CONTACT_LAWS:
+        if version < 2 and isinstance(law, str) and law != "hunt-crossley" and law in CONTACT_LAWS:
             raise SceneError(f"{key}.law", f"law {law!r} needs a version-2 scene (put version = 2 at the top); "
                                            "version 1 has only 'hunt-crossley'")
         return super().from_mapping(data, key, version)

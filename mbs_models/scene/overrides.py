@@ -206,7 +206,7 @@ def _rebuild(table: Table, tree: dict[str, Any], keys: dict[tuple, str], at: tup
         else:
             changes[field] = value
     law = changes.get("law")
-    if law in CONTACT_LAWS and law != getattr(table, "law", law):
+    if isinstance(law, str) and law in CONTACT_LAWS and law != getattr(table, "law", law):
         allowed = CONTACT_LAWS[law].fields + CONTACT_LAWS[law].optional
         for field in LAW_FIELDS:  # the old law's fields the new one does not have
             if field not in allowed and field not in changes and getattr(table, field, None) is not None:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 import math
 import tomllib
 
@@ -136,3 +137,38 @@ def test_the_version_2_message_names_the_first_table_as_its_key():
         scene_from_dict(data)
     assert info.value.key == "absorber"
     assert "([[absorber]], [absorber.contact], [recoil_brake])" in info.value.message
+
+
+@pytest.mark.parametrize("wrong", [[1.0, "a"], {"a": 1.0}, 1.0, True, []], ids=["list", "table", "number", "bool",
+                                                                                  "empty"])
+def test_every_text_key_of_a_wrong_type_is_one_scene_error(tmp_path, wrong):
+    """Every string-valued key of every shipped scene (a law, a mount, a name, a file) given another type, in a
+    file and by --set: a SceneError naming it, never another exception (found by tests/test_fuzz.py: an
+    unhashable list as a contact's law was looked up in the table of laws)."""
+    from fuzz_scenes import _leaves, _toml_text
+
+    from mbs_models import apply_overrides
+
+    for name in list_scenes():
+        data = tomllib.loads(scene_path(name).read_text())
+        for path, value in _leaves(data):
+            if not isinstance(value, str) or path == ("name",):
+                continue
+            changed = copy.deepcopy(data)
+            target = changed
+            for part in path[:-1]:
+                target = target[part]
+            target[path[-1]] = copy.deepcopy(wrong)
+            file = tmp_path / "scene.toml"
+            file.write_text(_toml_text(changed))
+            key = ".".join(str(p) for p in path)
+            try:
+                load_scene(file)
+            except SceneError as error:
+                assert "\n" not in str(error), (name, key)
+            if isinstance(wrong, (dict, list)) and not wrong:
+                continue
+            try:
+                apply_overrides(load_scene(scene_path(name)), {key: wrong})
+            except SceneError as error:
+                assert "\n" not in str(error), (name, key)
