@@ -135,6 +135,16 @@ class SerialBackend:
     def __exit__(self, *exc):
         self.close()
 
+    def _run_alone(self, function: Callable, task: Any) -> Iterator:
+        """Run a task that was running when a worker died on its own (``_alone``): its result, or its points'
+        lost rows once the task killed its worker again (``_losses``, kept by the backends with workers)."""
+        ran, result = self._alone(function, task)
+        if ran:
+            yield from self._losses.finished(task)
+            yield result
+        else:
+            yield from self._losses.add(task, result)
+
 
 class ProcessBackend(SerialBackend):
     """A local pool of ``workers`` processes (fork where available, else spawn), kept between runs."""
@@ -190,12 +200,7 @@ class ProcessBackend(SerialBackend):
                     if deaths == 0:
                         retry.extend((part, 1) for part in (split(task) if split is not None else [task]))
                         continue
-                    ran, result = self._alone(function, task)
-                    if ran:
-                        yield from self._losses.finished(task)
-                        yield result
-                    else:
-                        yield from self._losses.add(task, result)
+                    yield from self._run_alone(function, task)
             yield from self._losses.release()
             finished = True
         except BrokenProcessPool:   # without ``lost``, a death ends the run
@@ -402,12 +407,7 @@ class DaskBackend(SerialBackend):
                 yield from self._losses.finished(task)
                 yield result
             for task in suspects:
-                ran, result = self._alone(function, task)
-                if ran:
-                    yield from self._losses.finished(task)
-                    yield result
-                else:
-                    yield from self._losses.add(task, result)
+                yield from self._run_alone(function, task)
             yield from self._losses.release()
         except ClusterError:
             running.clear()   # nothing to cancel: the scheduler may be gone (a request would wait for it)

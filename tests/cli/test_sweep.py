@@ -9,7 +9,7 @@ import re
 import pandas as pd
 import pytest
 
-from mbs_models import model_i, simulate
+from mbs_models import model_i, run_sweep, simulate
 from mbs_models.cli import main
 
 GRID = ["--param", "absorber.mass=100,1000", "--param", "contact.gap=0:0.04:2"]
@@ -154,13 +154,22 @@ def _stopped(proc, out, reason: str) -> tuple[int, list[str]]:
     return int(match[1]), lines
 
 
+def _assert_resumes_to_the_uninterrupted_sweep(out, argv):
+    """Resuming the stopped sweep (one worker) gives exactly the table of an uninterrupted run."""
+    assert main([*argv, "--workers", "1"]) == 0
+    expected = run_sweep(model_i(), {"absorber.mass": "100,400,1000", "contact.gap": "0:0.1:100"}, end_time=1.0,
+                         accuracy="draft", workers=1, progress=False)
+    resumed = pd.read_csv(out, keep_default_na=False, na_values=[""])
+    expected_text = pd.read_csv(io.StringIO(expected.to_csv(index=False)), keep_default_na=False, na_values=[""])
+    pd.testing.assert_frame_equal(resumed.drop(columns="wall_time"), expected_text.drop(columns="wall_time"))
+
+
 @pytest.mark.slow
 def test_a_scheduler_killed_mid_sweep_exits_1_keeps_the_rows_and_resumes_exactly(tmp_path):
     """SIGKILL the Dask scheduler while rows are being written: one line (no traceback), exit 1, the rows kept;
     the same sweep again gives exactly the uninterrupted table (wall times aside)."""
     from dask_processes import dask_processes
 
-    from mbs_models import run_sweep
 
     out = tmp_path / "s.csv"
     with dask_processes(tmp_path) as cluster:
@@ -168,12 +177,7 @@ def test_a_scheduler_killed_mid_sweep_exits_1_keeps_the_rows_and_resumes_exactly
         cluster.kill_scheduler()
         rows, lines = _stopped(proc, out, re.escape(f"the Dask scheduler {cluster.address} was lost"))
     assert len(lines) == 2 and 13 <= rows < 300   # no traceback, no log line of distributed's
-    assert main([*argv, "--workers", "1"]) == 0
-    expected = run_sweep(model_i(), {"absorber.mass": "100,400,1000", "contact.gap": "0:0.1:100"}, end_time=1.0,
-                         accuracy="draft", workers=1, progress=False)
-    resumed = pd.read_csv(out, keep_default_na=False, na_values=[""])
-    expected_text = pd.read_csv(io.StringIO(expected.to_csv(index=False)), keep_default_na=False, na_values=[""])
-    pd.testing.assert_frame_equal(resumed.drop(columns="wall_time"), expected_text.drop(columns="wall_time"))
+    _assert_resumes_to_the_uninterrupted_sweep(out, argv)
 
 
 @pytest.mark.slow
@@ -301,7 +305,6 @@ def test_a_killed_sweep_resumes_to_exactly_the_uninterrupted_table(tmp_path):
     import sys
     import time
 
-    from mbs_models import run_sweep
 
     params = ["absorber.mass=100,400,1000", "contact.gap=0:0.1:100"]
     out = tmp_path / "s.csv"
@@ -323,12 +326,7 @@ def test_a_killed_sweep_resumes_to_exactly_the_uninterrupted_table(tmp_path):
     assert running, "the sweep ended before it could be killed"
     rows = out.read_bytes().count(b"\n") - 1
     assert 12 <= rows < 300
-    assert main([*argv, "--workers", "1"]) == 0
-    expected = run_sweep(model_i(), {"absorber.mass": "100,400,1000", "contact.gap": "0:0.1:100"}, end_time=1.0,
-                         accuracy="draft", workers=1, progress=False)
-    resumed = pd.read_csv(out, keep_default_na=False, na_values=[""])
-    expected_text = pd.read_csv(io.StringIO(expected.to_csv(index=False)), keep_default_na=False, na_values=[""])
-    pd.testing.assert_frame_equal(resumed.drop(columns="wall_time"), expected_text.drop(columns="wall_time"))
+    _assert_resumes_to_the_uninterrupted_sweep(out, argv)
 
 
 # ================================================================================================ faults
@@ -364,7 +362,6 @@ def _kill(proc) -> None:
 def _uninterrupted(monkeypatch, grid=None):
     import fake_points
 
-    from mbs_models import run_sweep
 
     fake_points.patch(monkeypatch)
     grid = grid or {"absorber.mass": "100,400,1000", "contact.gap": "0:0.1:101"}
