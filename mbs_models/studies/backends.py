@@ -216,10 +216,12 @@ class ProcessBackend(SerialBackend):
         died)`` if that process dies."""
         pool = local_pool(1)
         try:
+            future = pool.submit(function, task)
+            processes = list((getattr(pool, "_processes", None) or {}).values())  # before a death clears them
             try:
-                return True, pool.submit(function, task).result()
+                return True, future.result()
             except BrokenProcessPool:
-                return False, death_reason(pool)
+                return False, death_reason(processes)
         finally:
             pool.shutdown(wait=True, cancel_futures=True)
 
@@ -290,10 +292,12 @@ def _collect(done, running: dict) -> tuple[list, list]:
     return results, dead
 
 
-def death_reason(pool: ProcessPoolExecutor) -> str:
-    """Why the worker of a one-process pool died, for the ``error`` of its point: the signal or exit code."""
+def death_reason(processes) -> str:
+    """Why the worker of a one-process pool died, for the ``error`` of its point: the signal or exit code.
+    ``processes``: the pool's worker processes, taken when the task was submitted (once the pool has noticed
+    the death its own list may be gone: a loaded machine then lost the signal)."""
     codes = []
-    for process in list((getattr(pool, "_processes", None) or {}).values()):
+    for process in processes:
         try:
             process.join(timeout=5.0)   # the pool reports its death before it has reaped the process
         except (AssertionError, OSError, ValueError):
