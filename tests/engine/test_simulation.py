@@ -159,16 +159,16 @@ def test_chattering_contact_fails_clearly_instead_of_running_for_hours():
 @pytest.mark.parametrize("factory", [simplified_model, model_ii])
 def test_solver_that_stops_early_with_success_is_a_simulation_error(monkeypatch, factory):
     """Exudyn told to stop at half the end time returns success; that must not pass as a result."""
-    import mbs_models.engine.simulation as simulation
+    import mbs_models.engine.driver as driver
 
-    original = simulation.exudyn_simulation_settings
+    original = driver.exudyn_simulation_settings
 
     def stopping_halfway(settings, end_time, start_time=0.0):
         ss = original(settings, end_time, start_time)
         ss.timeIntegration.endTime = 0.5 * end_time
         return ss
 
-    monkeypatch.setattr(simulation, "exudyn_simulation_settings", stopping_halfway)
+    monkeypatch.setattr(driver, "exudyn_simulation_settings", stopping_halfway)
     with pytest.raises(SimulationError, match="stopped early at t = 0.5 s"):
         simulate(factory(), 1.0)
 
@@ -200,7 +200,7 @@ def test_first_same_as_last_solvers_skip_the_end_of_step_evaluation_bit_identica
     """DOPRI5's and ODE23's last stage is the end-of-step state, so the engine does not let Exudyn evaluate the
     forces again after each step; every shipped scene (shots, breech pulses: loads in time, segmented runs) gives
     the Result of the run that does, exactly."""
-    import mbs_models.engine.simulation as engine
+    import mbs_models.engine.driver as engine
 
     settings = SolverSettings(solver=solver, relative_tolerance=1e-6, absolute_tolerance=1e-8, max_step=5e-3)
     assert solver in engine.FIRST_SAME_AS_LAST_SOLVERS
@@ -236,7 +236,7 @@ def _contact_free_scenes():
 def test_the_budget_of_a_scene_without_contact_changes_no_result(scene, monkeypatch, assert_results_identical):
     """Every adaptive solve now counts its steps in a pre-step function; without it (as before issue #20) every
     contact-free shipped scene gives the same Result, bit for bit."""
-    import mbs_models.engine.simulation as engine
+    import mbs_models.engine.run_policy as engine
 
     budgeted = simulate(scene, 3.0)
     assert budgeted.steps > 0
@@ -249,7 +249,7 @@ def test_a_scene_without_contact_is_stopped_by_the_step_budget_naming_its_stiff_
     """The budget bounds contact-free solves too (a stiff spring the up-front check lets through, a budget of
     500 steps for the 2000 this run takes); the message names what is fast."""
     import mbs_models.engine.guard as guard
-    import mbs_models.engine.simulation as engine
+    import mbs_models.engine.run_policy as engine
     from mbs_models.scene.overrides import apply_overrides
 
     monkeypatch.setattr(guard, "MINIMUM_STEP_BUDGET", 500)
@@ -286,7 +286,7 @@ def test_a_fixed_step_run_with_many_sensors_is_thinned_to_the_cap(monkeypatch):
 
 def test_ctrl_c_during_a_solve_is_a_keyboard_interrupt_not_a_failed_solve(monkeypatch):
     """Exudyn reports an interrupt inside the solve as its own error; simulate raises KeyboardInterrupt."""
-    import mbs_models.engine.simulation as engine
+    import mbs_models.engine.driver as engine
 
     original = engine._pre_step_function
 
@@ -309,7 +309,7 @@ def test_ctrl_c_during_a_solve_is_a_keyboard_interrupt_not_a_failed_solve(monkey
 
 
 def test_an_error_caused_by_an_interrupt_is_recognised_down_its_chain():
-    from mbs_models.engine.simulation import _interrupted
+    from mbs_models.engine.driver import _interrupted
 
     try:
         try:
@@ -339,7 +339,7 @@ def test_too_many_absorbers_are_refused_before_anything_else(tmp_path, recwarn):
 
 @pytest.mark.parametrize("name, key", [("breech_pulse", "firing.pulse.times"), ("burst", "burst.shots")])
 def test_a_run_split_into_too_many_segments_is_refused_naming_the_key(name, key, monkeypatch):
-    import mbs_models.engine.simulation as engine
+    import mbs_models.engine.run_policy as engine
     from mbs_models import load_scene
     from mbs_models.scenes import scene_path
 
@@ -414,7 +414,7 @@ def test_solves_run_with_exudyns_throw_on_ctrl_c_and_restore_it(monkeypatch):
     the minimum step size never ends (DESIGN.md, Exudyn notes); the engine's solves throw at once."""
     import exudyn
 
-    import mbs_models.engine.simulation as engine
+    import mbs_models.engine.driver as engine
 
     original, seen = engine._pre_step_function, []
 
