@@ -96,7 +96,7 @@ def breakdown_round(scene, end_time: float, stages: dict[str, list[float]]) -> N
     from mbs_models.engine.mechanism import Mechanism
     from mbs_models.results.postprocess import Interpolant, analyse, energies, find_impacts
 
-    engine = importlib.import_module("mbs_models.engine.simulation")
+    engine = importlib.import_module("mbs_models.engine.driver")
     settings = solver_settings_for("standard")
 
     def timed(name, function, *args):
