@@ -18,7 +18,7 @@ class StopReason(StrEnum):
     #: Integrated to the requested end time (no early stop asked for, or none proven).
     END_TIME = "end_time", "reached the end of the window"
     #: Every metric named in ``stop_when_final`` was proven final by energy bounds before the end time.
-    METRICS_FINAL = "metrics_final", "every metric is final (energy bounds)"
+    METRICS_FINAL = "metrics_final", "every metric asked for is final (proven by energy bounds)"
     #: An early stop was asked for, but the scene injects energy (no bound): run to the end time.
     NO_ENERGY_BOUND = "end_time_no_energy_bound", "reached the end of the window: the scene has no energy bound"
     #: Stopped early, but the solution's energy rose by more than the bounds' slack: re-solved to the end time.

@@ -138,8 +138,10 @@ class Result:
     rest_tolerance: float | None = None
 
     def __post_init__(self):
-        if self.requested_end_time is None:  # (while it is built: frozen from then on)
+        # (while it is built: frozen from then on)
+        if self.requested_end_time is None:
             object.__setattr__(self, "requested_end_time", self.end_time)
+        object.__setattr__(self, "stop_reason", StopReason(self.stop_reason))  # its text (an old value) read back
 
     # ------------------------------------------------------------------ version-1 shortcuts
     @property
@@ -357,7 +359,7 @@ class Result:
         if self.rest_time is not None:
             window += f" (at rest from {self.rest_time:.6g} s)"
         elif self.stop_reason != StopReason.END_TIME:
-            window += f" of {self.requested_end_time:g} s requested ({self.stop_reason.replace('_', ' ')})"
+            window += f" of {self.requested_end_time:g} s requested: {self.stop_reason.message}"
         name, label = self.scene.name, self.scene.model_label
         header = name if label.lower() in name.lower() else f"{name} ({label})"  # the model named once
         lines = [f"{header}, {window}, {self.settings.label()}"]

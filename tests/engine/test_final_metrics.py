@@ -119,6 +119,7 @@ def test_unproven_metrics_are_none_and_summaries_still_work():
     assert metrics["impacts"] is None and metrics["end_time"] < metrics["requested_end_time"] == 10.0
     assert metrics["stop_reason"] == "metrics_final"
     assert "not proven final" in early.summary() and "10 s requested" in early.summary()
+    assert "10 s requested: every metric asked for is final (proven by energy bounds)," in early.summary()  # StopReason.METRICS_FINAL's message
 
 
 def test_zero_recoil_stiffness_has_no_displacement_bound():

@@ -71,3 +71,6 @@ def test_a_result_is_immutable_and_a_changed_copy_is_a_new_result():
         result.contacts["contact"].peak_force = None
     longer = dataclasses.replace(result, requested_end_time=2.0)
     assert longer.requested_end_time == 2.0 and result.requested_end_time == 0.3
+    assert dataclasses.replace(result, stop_reason="at_rest").stop_reason is StopReason.AT_REST  # read from its text
+    with pytest.raises(ValueError):
+        dataclasses.replace(result, stop_reason="stopped")
