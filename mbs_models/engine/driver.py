@@ -3,7 +3,7 @@
 :func:`drive` is the one entry (:func:`mbs_models.engine.simulation.simulate` calls it): it assembles the scene
 (from :class:`FreshModels` or a :class:`~mbs_models.engine.reuse.Simulator`), solves it from 0 to the end time
 (:func:`_solve`; :func:`_run_segments` for a scene with shots, loads or a rest watch), reads the sensors into
-:class:`~mbs_models.results.postprocess.Samples`, and re-solves a run that
+:class:`~mbs_models.results.postprocess.Samples` (:mod:`mbs_models.engine.readout`), and re-solves a run that
 
 * stepped over a whole contact with a smaller ``max_step`` (:func:`_settings_after_stepped_over_contacts`,
   at most :data:`MAX_CONTACT_RETRIES` times);
@@ -31,6 +31,7 @@ from .assembly import Assembly, assemble
 from .final_metrics import FinalityTracker
 from .guard import StepBudget, sample_cap
 from .mechanism import Mechanism
+from .readout import collect, read_segment
 from .rest import RestWatch
 from .run_policy import RunPolicy, _check_bounds
 from .time_scales import time_scale_hint
@@ -308,59 +309,6 @@ def _initial_accelerations(assembly: Assembly, t: float = 0.0) -> dict[str, floa
     return {body: float(accelerations[data.GetNodeLTGODE2(node)[0]]) for body, node in assembly.nodes.items()}
 
 
-def _stored(assembly: Assembly, name: str) -> np.ndarray:
-    return np.asarray(assembly.mbs.GetSensorStoredData(assembly.sensors[name]), dtype=float)
-
-
-def _read_segment(assembly: Assembly, settings: SolverSettings, start_time: float = 0.0,
-                  initial_accelerations: dict[str, float] | None = None) -> tuple[np.ndarray, dict[str, np.ndarray]]:
-    """The sensors of the last solve: (time s, values by sensor name), duplicate time stamps dropped;
-    SimulationError for NaN/inf."""
-    columns = {name: _stored(assembly, name) for name in assembly.sensors}
-    for body, value in (initial_accelerations or {}).items():
-        data = columns[f"{body}_acceleration"]
-        if len(data) and data[0, 0] == start_time:
-            data[0, 1] = value  # Exudyn records 0 at the start (see _initial_accelerations)
-    for name, data in columns.items():
-        if not np.isfinite(data).all():
-            first = int(np.flatnonzero(~np.all(np.isfinite(data), axis=1))[0])
-            raise SimulationError(f"Exudyn {settings.solver} produced a non-finite {name.replace('_', ' ')} at "
-                                  f"t = {data[first, 0]:.6g} s (the solve diverged; try a smaller step or "
-                                  "tighter tolerance)")
-    time = columns["barrel_position"][:, 0]
-    later = time[1:] > time[:-1]
-    rows = slice(None) if later.all() else np.concatenate([[True], later])  # drop duplicate time stamps, if any
-    return (np.ascontiguousarray(time[rows]),
-            {name: np.ascontiguousarray(data[rows, 1]) for name, data in columns.items()})
-
-
-def _collect(assembly: Assembly, end_time: float, settings: SolverSettings,
-             initial_accelerations: dict[str, float] | None = None, segments: list | None = None) -> Samples:
-    """Read the sensors into :class:`Samples`; raise SimulationError for NaN/inf or missing output.
-
-    ``segments``: the ``(time, values)`` of every segment of a segmented run (:func:`_run_segments`),
-    joined in order; the sample at a segment boundary appears twice, before and after it (a velocity
-    jump of a shot, a jump of the breech force): a zero-length interval the post-processing skips.
-    """
-    if segments is None:
-        segments = [_read_segment(assembly, settings, 0.0, initial_accelerations)]
-    if len(segments) == 1:
-        time, values = segments[0]
-    else:
-        time = np.concatenate([t for t, _ in segments])
-        values = {name: np.concatenate([v[name] for _, v in segments]) for name in assembly.sensors}
-    if len(time) < 2:
-        raise SimulationError(f"Exudyn {settings.solver} produced fewer than two output samples")
-    if abs(time[-1] - end_time) > 1e-6 * max(1.0, end_time):
-        raise SimulationError(f"Exudyn {settings.solver} output ends at t = {time[-1]:.6g} s, not at {end_time:g} s")
-    bodies = [body.name for body in assembly.mechanism.bodies]
-    return Samples(time=time, positions={b: values[f"{b}_position"] for b in bodies},
-                   velocities={b: values[f"{b}_velocity"] for b in bodies},
-                   accelerations={b: values[f"{b}_acceleration"] for b in bodies},
-                   forces={c.name: values[f"{c.name}_force"] for c in assembly.mechanism.connectors
-                           if c.records_force})
-
-
 #: Steps at least per window where a load varies (a breech pulse): the step is limited to its length / this.
 STEPS_PER_LOAD_WINDOW = 40
 
@@ -412,14 +360,14 @@ def _run_segments(assembly: Assembly, settings: SolverSettings, end_time: float,
             load.start_segment(t0)
         n, simulated_end = _solve(assembly, segment_settings, t1, tracker, t0, run)
         steps += n
-        segments.append(_read_segment(assembly, settings, t0, accelerations))
+        segments.append(read_segment(assembly, settings, t0, accelerations))
         if tracker is not None and tracker.done:
             break
         settled = rest.settle(t0, t1, segments[-1]) if rest is not None else None
         if settled is not None:
             segments[-1], simulated_end = settled, rest.time
             break
-    return steps, simulated_end, _collect(assembly, simulated_end, settings, segments=segments)
+    return steps, simulated_end, collect(assembly, simulated_end, settings, segments=segments)
 
 
 def _settings_after_stepped_over_contacts(mechanism: Mechanism, samples: Samples, settings: SolverSettings,
@@ -515,7 +463,7 @@ def drive(models: FreshModels, scene: Scene, policy: RunPolicy) -> Solve:
                 initial_accelerations = _initial_accelerations(assembly)
                 steps, simulated_end = _solve(assembly, settings, end_time, tracker)
                 solved = _time.perf_counter()
-                samples = _collect(assembly, simulated_end, settings, initial_accelerations)
+                samples = collect(assembly, simulated_end, settings, initial_accelerations)
             failed = False
         except _StepSizeStalled as stalled:
             retry = _absolute_tolerance_settings(settings) if settings.adaptive else None

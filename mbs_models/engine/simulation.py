@@ -36,8 +36,6 @@ run ended: :class:`~mbs_models.stop_reason.StopReason`), and the Result is built
 
 from __future__ import annotations
 
-from __future__ import annotations
-
 import time as _time
 from typing import Sequence
 
