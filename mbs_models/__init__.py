@@ -22,6 +22,7 @@ import importlib
 from .errors import ClusterError, RecoilError, SceneError, SimulationError, UnitWarning
 from .scene import (TABLE_CLASSES, Conventions, Scene, apply_overrides, load_scene, model_i, model_ii, paper_model,
                     parse_spec, scene_from_dict, scene_to_dict, scene_to_toml, simplified_model)
+from .stop_reason import StopReason
 
 globals().update(TABLE_CLASSES)  # Barrel, RecoilSpring, Absorber, Contact, ...: every element's table
 
@@ -53,7 +54,7 @@ _LAZY = {
 }
 
 __all__ = [
-    *TABLE_CLASSES, "Conventions", "Scene",
+    *TABLE_CLASSES, "Conventions", "Scene", "StopReason",
     "RecoilError", "SceneError", "SimulationError", "ClusterError", "UnitWarning",
     "load_scene", "scene_from_dict", "scene_to_dict", "scene_to_toml", "apply_overrides", "parse_spec",
     "model_i", "model_ii", "paper_model", "simplified_model",

@@ -96,7 +96,8 @@ def breakdown_round(scene, end_time: float, stages: dict[str, list[float]]) -> N
     from mbs_models.engine.mechanism import Mechanism
     from mbs_models.results.postprocess import Interpolant, analyse, energies, find_impacts
 
-    engine = importlib.import_module("mbs_models.engine.simulation")
+    engine = importlib.import_module("mbs_models.engine.driver")
+    readout = importlib.import_module("mbs_models.engine.readout")
     settings = solver_settings_for("standard")
 
     def timed(name, function, *args):
@@ -111,7 +112,7 @@ def breakdown_round(scene, end_time: float, stages: dict[str, list[float]]) -> N
     try:
         accelerations = timed("initial accelerations", engine._initial_accelerations, assembly)
         timed("solve (Exudyn SolveDynamic)", engine._solve, assembly, settings, end_time)
-        samples = timed("collect sensor data", engine._collect, assembly, end_time, settings, accelerations)
+        samples = timed("collect sensor data", readout.collect, assembly, end_time, settings, accelerations)
     finally:
         timed("release model (Reset)", assembly.close)
     timed("stepped-over-contact check", engine._settings_after_stepped_over_contacts, mechanism, samples, settings,

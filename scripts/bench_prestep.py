@@ -8,7 +8,7 @@ Every sweep point runs ``simulate(scene, 10.0, "standard", stop_when_final=("max
 on a reused model; Exudyn calls the engine's Python pre-step function (step budget, onset capture,
 finality tracker) at every step.  This script loads the ref's ``engine/guard.py``, ``final_metrics.py`` and
 ``simulation.py`` beside this checkout's (module names ``mbs_models.engine._ref_*``; everything else is
-shared), runs every point with both, alternating which goes first, and prints
+shared: against a ref with ``driver.py``, its solves are this checkout's), runs every point with both, alternating which goes first, and prints
 
 * the CPU time (``time.process_time``) per point, median over ``--rounds``, summed over the points, and the
   ratio ref / this;
@@ -122,14 +122,14 @@ def budget_only_solves(ref, rounds: int) -> dict[str, float]:
     import exudyn
 
     from mbs_models import model_ii
-    from mbs_models.engine import guard, simulation
+    from mbs_models.engine import driver, guard
     from mbs_models.engine.accuracy import solver_settings_for
     from mbs_models.engine.assembly import assemble
 
     ref_guard = sys.modules["mbs_models.engine._ref_guard"]
     settings = solver_settings_for("standard", "symbolic")
     installs = {"ref": lambda a: ref._pre_step_function(a, ref_guard.StepBudget(ref_guard.step_budget(10.0)), None),
-                "this": lambda a: simulation._pre_step_function(a, guard.StepBudget(guard.step_budget(10.0)), None),
+                "this": lambda a: driver._pre_step_function(a, guard.StepBudget(guard.step_budget(10.0)), None),
                 "none": None}
     cpu = {kind: [] for kind in installs}
     for r in range(rounds):
@@ -138,7 +138,7 @@ def budget_only_solves(ref, rounds: int) -> dict[str, float]:
             try:
                 if installs[kind] is not None:
                     assembly.mbs.SetPreStepUserFunction(installs[kind](assembly))
-                ss = simulation.exudyn_simulation_settings(settings, 10.0)
+                ss = driver.exudyn_simulation_settings(settings, 10.0)
                 exudyn.config.printToConsole = False
                 start = time.process_time()
                 assembly.mbs.SolveDynamic(ss, solverType=getattr(exudyn.DynamicSolverType, settings.solver))
@@ -155,6 +155,7 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
 
     from mbs_models import Simulator
+    from mbs_models.engine import driver
     from mbs_models.engine import simulation as this
 
     ref = load_ref(args.against)
@@ -187,7 +188,7 @@ def main(argv=None) -> int:
 
         # the pre-step's share, in a separate pass with the timing wrapper (interleaved the same way)
         overhead = wrapper_overhead_ns()
-        modules = {"ref": ref, "this": this}
+        modules = {"ref": ref, "this": driver}  # where each side's pre-step function is looked up
         totals = {kind: [0, 0] for kind in runs}
         elapsed = {kind: 0.0 for kind in runs}
         originals = {kind: timed_pre_step(modules[kind], totals[kind]) for kind in runs}

@@ -30,7 +30,7 @@ sys.path.insert(0, str(ROOT))
 
 from mbs_models import load_scene, simulate  # noqa: E402
 from mbs_models.elements.barrel import BARREL  # noqa: E402
-from mbs_models.engine import simulation  # noqa: E402
+from mbs_models.engine import driver, result_builder  # noqa: E402
 from mbs_models.results import postprocess  # noqa: E402
 from mbs_models.results.peaks import refine_maximum  # noqa: E402
 from mbs_models.results.refinement import refine  # noqa: E402
@@ -40,17 +40,17 @@ from mbs_models.scenes import scene_path  # noqa: E402
 def captured_samples(scene, end_time: float):
     """The mechanism and samples ``simulate`` hands to ``analyse`` (captured by wrapping it once)."""
     seen = {}
-    original = simulation.analyse
+    original = result_builder.analyse
 
     def spy(mechanism, samples, *args, **kwargs):
         seen["mechanism"], seen["samples"] = mechanism, samples
         return original(mechanism, samples, *args, **kwargs)
 
-    simulation.analyse = spy
+    result_builder.analyse = spy
     try:
         simulate(scene, end_time, "standard")
     finally:
-        simulation.analyse = original
+        result_builder.analyse = original
     return seen["mechanism"], seen["samples"]
 
 
@@ -66,7 +66,7 @@ def timed(function, *args) -> float:
 def solve_clock():
     """Wrap the engine's solve so that each call's time on :data:`CLOCK` is appended to the returned list."""
     seconds = []
-    original = simulation._solve
+    original = driver._solve
 
     def clocked(*args, **kwargs):
         start = CLOCK()
@@ -75,7 +75,7 @@ def solve_clock():
         finally:
             seconds.append(CLOCK() - start)
 
-    simulation._solve = clocked
+    driver._solve = clocked
     return seconds
 
 

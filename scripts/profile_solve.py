@@ -34,7 +34,7 @@ from mbs_models import model_ii  # noqa: E402
 from mbs_models.engine.accuracy import solver_settings_for  # noqa: E402
 from mbs_models.engine.assembly import assemble  # noqa: E402
 from mbs_models.engine.guard import StepBudget, step_budget  # noqa: E402
-from mbs_models.engine.simulation import _pre_step_function, exudyn_simulation_settings  # noqa: E402
+from mbs_models.engine.driver import _pre_step_function, exudyn_simulation_settings  # noqa: E402
 
 END = 10.0
 

@@ -32,3 +32,45 @@ def test_public_names_resolve():
     for name in mbs_models.__all__:
         assert getattr(mbs_models, name) is not None, name
     assert isinstance(mbs_models.simulate, types.FunctionType)
+
+
+# ------------------------------------------------------------------ who imports what (issue #21)
+def _effect_modules() -> set[str]:
+    """The element modules that hold an effect: those defining a table of the registry, but the barrel's (every
+    scene's reference body, which the engine and the results name as ``BARREL``)."""
+    from mbs_models.elements import TABLES
+    from mbs_models.elements.barrel import Barrel
+
+    return {table.__module__ for table in TABLES.values()} - {Barrel.__module__}
+
+
+def _effects_imported(path, source: str | None = None) -> list[str]:
+    """``line: module`` of every import in ``path`` (or ``source`` read as that file) of an effect's module."""
+    from imports import imports_of
+
+    effects = _effect_modules()
+    return [f"{line}: {module}" for line, module in imports_of(path, source) if module in effects]
+
+
+def test_the_effect_import_check_can_fail():
+    """Each way of importing an effect's module is found, relative or absolute; the infrastructure is not one."""
+    from imports import REPO
+
+    path = REPO / "mbs_models" / "engine" / "mechanism.py"
+    for source in ("from ..elements.end_stops import RecoilStop", "from ..elements import end_stops",
+                   "import mbs_models.elements.cradle", "def f():\n    from mbs_models.elements.recuperator import X"):
+        assert len(_effects_imported(path, source)) == 1, source
+    assert not _effects_imported(path, "from ..elements.connector import GROUND\nfrom ..elements import TABLES\n"
+                                       "from ..elements.barrel import BARREL")
+    assert "mbs_models.elements.absorber" in _effect_modules() and len(_effect_modules()) >= 8
+
+
+def test_the_engine_and_the_results_import_no_effect():
+    """Adding an effect touches no engine or results module (README, "Adding an effect"): they import the elements'
+    infrastructure (connector, table, the registry) and the barrel, never an effect's own module."""
+    from imports import REPO
+
+    files = sorted((REPO / "mbs_models" / "engine").rglob("*.py")) + sorted((REPO / "mbs_models" / "results").rglob("*.py"))
+    assert len(files) >= 20
+    bad = [f"{path.relative_to(REPO)}:{found}" for path in files for found in _effects_imported(path)]
+    assert not bad, "modules of the engine or the results import an effect's module:\n" + "\n".join(bad)

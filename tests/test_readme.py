@@ -70,23 +70,6 @@ def test_the_version_2_example_runs(capsys):
     assert lines[0].startswith("front ") and lines[1].startswith("rear ")
 
 
-def test_the_files_that_know_about_an_effect_are_the_ones_listed():
-    """The README lists, for the end stops, every file that knows about them: no other source, scene or test
-    file of the repository names them (their module, tables or classes)."""
-    import subprocess
-
-    text = README.read_text()
-    block = text[text.index("<!-- effect-files: end_stops -->"):text.index("<!-- /effect-files -->")]
-    listed = set(re.findall(r"^- `([^`]+)`", block, flags=re.M))
-    root = README.parent
-    tracked = subprocess.run(["git", "ls-files", "--cached", "--others", "--exclude-standard"], cwd=root,
-                             capture_output=True, text=True, check=True).stdout.split()
-    names = re.compile(r"end_stops|recoil_stop|battery_stop|RecoilStop|BatteryStop")
-    knowing = {path for path in tracked if path.endswith((".py", ".toml")) and path != "tests/test_readme.py"
-               and names.search((root / path).read_text(errors="replace"))}  # (this checker names them, of course)
-    assert knowing == listed
-
-
 def test_the_sweep_example_runs_and_gives_the_table(capsys):
     """The README's run_sweep example: a 2 x 2 grid, every point ok."""
     namespace: dict = {}

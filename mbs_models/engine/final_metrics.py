@@ -90,6 +90,7 @@ from ..elements.connector import GROUND
 from ..errors import SceneError
 from ..results.result import ALL_METRICS
 from ..scene import Scene
+from ..stop_reason import StopReason
 from .mechanism import Mechanism
 
 #: Metrics that can be proven final before the end time (names of :class:`~mbs_models.results.result.Result` fields).
@@ -97,12 +98,12 @@ FINAL_METRICS = ALL_METRICS
 #: Relative margin on the energy in every bound: covers the integration error of the solution's
 #: energy (a relative rise of ~1e-9 per step at the presets' tolerances; see largest_energy_rise).
 ENERGY_SLACK = 1e-4
-#: Why a run ended (``Result.stop_reason``).
-STOP_END_TIME = "end_time"                  # reached the requested end time (no early stop asked, or not proven)
-STOP_METRICS_FINAL = "metrics_final"        # every metric named in stop_when_final was proven final
-STOP_NO_BOUND = "end_time_no_energy_bound"  # early stop asked, but the scene injects energy (literal_lambda_sign)
-STOP_ENERGY_CHECK = "end_time_energy_check"  # stopped early, but the energy error exceeded the slack: re-solved
-STOP_AT_REST = "at_rest"                    # proven within the tolerance of the rest state: held to the end time
+#: Why a run ended (``Result.stop_reason``): the members of :class:`~mbs_models.stop_reason.StopReason`.
+STOP_END_TIME = StopReason.END_TIME
+STOP_METRICS_FINAL = StopReason.METRICS_FINAL
+STOP_NO_BOUND = StopReason.NO_ENERGY_BOUND
+STOP_ENERGY_CHECK = StopReason.ENERGY_CHECK
+STOP_AT_REST = StopReason.AT_REST
 #: The metrics :meth:`FinalityTracker.check` decides together.
 _CONTACT_METRICS = ("peak_contact_force", "impacts", "max_absorber_velocity")
 _CONTACT_METRICS_SET = frozenset(_CONTACT_METRICS)

@@ -22,7 +22,7 @@ The budget is the smaller of
   notice).  Runs that come to rest stop there (:mod:`mbs_models.engine.rest`) and store no more.
 
 Fixed-step solvers take the number of steps they are given (at most ``stability.MAX_STEPS``) and store at most
-:func:`sample_cap` samples: their output is thinned beyond it (``simulation.exudyn_simulation_settings``).
+:func:`sample_cap` samples: their output is thinned beyond it (``driver.exudyn_simulation_settings``).
 
 Cost: the engine's pre-step function counts the steps itself and calls :meth:`StepBudget.advance` only at
 the budget's checkpoints (:attr:`StepBudget.next_check`: every :data:`STALL_WINDOW_STEPS`-th step and the

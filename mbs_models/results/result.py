@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 
 from ..elements.barrel import BARREL
+from ..stop_reason import StopReason
 
 #: Every metric a run can report (and prove final with ``stop_when_final``).
 ALL_METRICS = ("max_barrel_displacement", "peak_contact_force", "max_absorber_velocity", "impacts",
@@ -40,7 +41,7 @@ class Impact:
                 "time_of_peak_force": self.time_of_peak_force, "contact": self.contact}
 
 
-@dataclass
+@dataclass(frozen=True)
 class ContactOutput:
     """One contact of a run: its force history (N, at the output times), refined peak and impacts.
 
@@ -65,7 +66,7 @@ class ContactOutput:
                 "impacts": None if self.impacts is None else [i.to_dict() for i in self.impacts]}
 
 
-@dataclass
+@dataclass(frozen=True)
 class Result:
     """Time histories (numpy arrays at the solver's output steps, SI units) and metrics of one run.
 
@@ -93,6 +94,11 @@ class Result:
     velocity within it (m/s); the histories are integrated up to ``rest_time`` and hold the rest state from
     there (a sample at ``rest_time`` and one at ``end_time``, the requested end time; velocities, accelerations
     0).  ``rest_time`` and ``rest_tolerance`` are None otherwise.
+
+    ``stop_reason`` (:class:`~mbs_models.stop_reason.StopReason`, a string: ``"end_time"``, ``"metrics_final"``...)
+    says why the run ended, ``stop_reason.message`` in words.  A Result is immutable: it is built once, from
+    everything the run collected (:mod:`mbs_models.engine.result_builder`); assigning to an attribute raises
+    ``dataclasses.FrozenInstanceError``.
     """
 
     scene: Any
@@ -126,14 +132,16 @@ class Result:
     timings: dict[str, float] = field(default_factory=dict)
     steps: int = 0
     requested_end_time: float | None = None
-    stop_reason: str = "end_time"
+    stop_reason: StopReason = StopReason.END_TIME
     final_metrics: tuple[str, ...] = ALL_METRICS
     rest_time: float | None = None
     rest_tolerance: float | None = None
 
     def __post_init__(self):
+        # (while it is built: frozen from then on)
         if self.requested_end_time is None:
-            self.requested_end_time = self.end_time
+            object.__setattr__(self, "requested_end_time", self.end_time)
+        object.__setattr__(self, "stop_reason", StopReason(self.stop_reason))  # its text (an old value) read back
 
     # ------------------------------------------------------------------ version-1 shortcuts
     @property
@@ -183,12 +191,12 @@ class Result:
     @property
     def kinetic_energy_history(self) -> np.ndarray:
         """Kinetic energy of all bodies (J) at the output times."""
-        return _sum(self.kinetic_energy_histories.values(), self.time)
+        return total_history(self.kinetic_energy_histories.values(), self.time)
 
     @property
     def stored_energy_history(self) -> np.ndarray:
         """Energy stored in all springs and contacts (J) at the output times."""
-        return _sum(self.stored_energy_histories.values(), self.time)
+        return total_history(self.stored_energy_histories.values(), self.time)
 
     # ------------------------------------------------------------------ energy
     @property
@@ -212,7 +220,7 @@ class Result:
     @property
     def work_history(self) -> np.ndarray:
         """Work (J) done on the mechanism by every external input (breech force, shots, gravity) since t = 0."""
-        return _sum(self.work_histories.values(), self.time)
+        return total_history(self.work_histories.values(), self.time)
 
     def energy(self) -> dict[str, dict[str, float]]:
         """Per element at the end time, J: ``{element: {"kinetic": ..., "stored": ..., "dissipated": ...}}``.
@@ -350,8 +358,8 @@ class Result:
         window = f"{self.end_time:g} s"
         if self.rest_time is not None:
             window += f" (at rest from {self.rest_time:.6g} s)"
-        elif self.stop_reason != "end_time":
-            window += f" of {self.requested_end_time:g} s requested ({self.stop_reason.replace('_', ' ')})"
+        elif self.stop_reason != StopReason.END_TIME:
+            window += f" of {self.requested_end_time:g} s requested: {self.stop_reason.message}"
         name, label = self.scene.name, self.scene.model_label
         header = name if label.lower() in name.lower() else f"{name} ({label})"  # the model named once
         lines = [f"{header}, {window}, {self.settings.label()}"]
@@ -412,7 +420,8 @@ class Result:
         return "\n".join(lines)
 
 
-def _sum(arrays, like) -> np.ndarray:
+def total_history(arrays, like: np.ndarray) -> np.ndarray:
+    """The sum of the histories ``arrays`` (added in their order), zeros like ``like`` if there is none."""
     total = None
     for array in arrays:
         total = array if total is None else total + array

@@ -119,8 +119,8 @@ def result_row(result, scene: Scene) -> dict[str, Any]:
         impacts = entry.get("impacts")
         row[f"{stop}.impacts"] = None if impacts is None else len(impacts)
         row[f"{stop}.dissipated_energy"] = entry.get("dissipated_energy")
-    row.update(initial_velocity=scene.initial_velocity, end_time=result.end_time, stop_reason=result.stop_reason,
-               steps=result.steps)
+    row.update(initial_velocity=scene.initial_velocity, end_time=result.end_time,
+               stop_reason=str(result.stop_reason), steps=result.steps)  # the StopReason's text: tables hold strings
     return row
 
 

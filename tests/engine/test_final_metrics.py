@@ -119,6 +119,7 @@ def test_unproven_metrics_are_none_and_summaries_still_work():
     assert metrics["impacts"] is None and metrics["end_time"] < metrics["requested_end_time"] == 10.0
     assert metrics["stop_reason"] == "metrics_final"
     assert "not proven final" in early.summary() and "10 s requested" in early.summary()
+    assert "10 s requested: every metric asked for is final (proven by energy bounds)," in early.summary()  # StopReason.METRICS_FINAL's message
 
 
 def test_zero_recoil_stiffness_has_no_displacement_bound():
@@ -129,9 +130,9 @@ def test_zero_recoil_stiffness_has_no_displacement_bound():
 
 
 def test_an_energy_rise_beyond_the_slack_makes_the_run_go_to_the_end(monkeypatch):
-    import mbs_models.engine.simulation as simulation
+    import mbs_models.engine.run_policy as run_policy
 
-    monkeypatch.setattr(simulation, "ENERGY_SLACK", -1.0)  # any history "rises" more than this
+    monkeypatch.setattr(run_policy, "ENERGY_SLACK", -1.0)  # any history "rises" more than this
     result = simulate(model_ii(1000.0, 0.0), 3.0, stop_when_final=("max_barrel_displacement",))
     assert result.stop_reason == fm.STOP_ENERGY_CHECK
     assert result.end_time == 3.0 and result.final_metrics == ALL and result.impacts is not None

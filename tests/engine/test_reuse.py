@@ -124,19 +124,19 @@ def test_refill_refuses_another_structure_and_the_cache_falls_back_to_a_fresh_bu
 
 def test_a_failed_solve_discards_its_system(monkeypatch, assert_results_identical):
     from mbs_models import SimulationError
-    from mbs_models.engine import simulation
+    from mbs_models.engine import driver
 
     with Simulator() as simulator:
         simulator.simulate(model_ii(500.0, 0.0), 10.0, "draft", stop_when_final=EARLY)
-        original = simulation._solve
+        original = driver._solve
 
         def failing(*args, **kwargs):
             raise SimulationError("made to fail")
 
-        monkeypatch.setattr(simulation, "_solve", failing)
+        monkeypatch.setattr(driver, "_solve", failing)
         with pytest.raises(SimulationError, match="made to fail"):
             simulator.simulate(model_ii(500.0, 0.01), 10.0, "draft", stop_when_final=EARLY)
-        monkeypatch.setattr(simulation, "_solve", original)
+        monkeypatch.setattr(driver, "_solve", original)
         assembled = simulator.assemblies
         scene = model_ii(500.0, 0.02)
         assert_results_identical(simulator.simulate(scene, 10.0, "draft", stop_when_final=EARLY),

@@ -159,16 +159,16 @@ def test_chattering_contact_fails_clearly_instead_of_running_for_hours():
 @pytest.mark.parametrize("factory", [simplified_model, model_ii])
 def test_solver_that_stops_early_with_success_is_a_simulation_error(monkeypatch, factory):
     """Exudyn told to stop at half the end time returns success; that must not pass as a result."""
-    import mbs_models.engine.simulation as simulation
+    import mbs_models.engine.driver as driver
 
-    original = simulation.exudyn_simulation_settings
+    original = driver.exudyn_simulation_settings
 
     def stopping_halfway(settings, end_time, start_time=0.0):
         ss = original(settings, end_time, start_time)
         ss.timeIntegration.endTime = 0.5 * end_time
         return ss
 
-    monkeypatch.setattr(simulation, "exudyn_simulation_settings", stopping_halfway)
+    monkeypatch.setattr(driver, "exudyn_simulation_settings", stopping_halfway)
     with pytest.raises(SimulationError, match="stopped early at t = 0.5 s"):
         simulate(factory(), 1.0)
 
@@ -184,40 +184,6 @@ def test_the_docstring_example_of_simulate_holds():
     runner = doctest.DocTestRunner(optionflags=doctest.ELLIPSIS)
     runner.run(test)
     assert runner.summarize(verbose=False).failed == 0 and len(test.examples) >= 3
-
-
-def _every_shipped_scene():
-    from mbs_models import load_scene
-    from mbs_models.scenes import list_scenes, scene_path
-
-    return [pytest.param(load_scene(scene_path(name)), id=name) for name in list_scenes()]
-
-
-@pytest.mark.parametrize("solver", ["DOPRI5", "ODE23"])
-@pytest.mark.parametrize("scene", _every_shipped_scene())
-def test_first_same_as_last_solvers_skip_the_end_of_step_evaluation_bit_identically(
-        scene, solver, monkeypatch, assert_results_identical):
-    """DOPRI5's and ODE23's last stage is the end-of-step state, so the engine does not let Exudyn evaluate the
-    forces again after each step; every shipped scene (shots, breech pulses: loads in time, segmented runs) gives
-    the Result of the run that does, exactly."""
-    import mbs_models.engine.simulation as engine
-
-    settings = SolverSettings(solver=solver, relative_tolerance=1e-6, absolute_tolerance=1e-8, max_step=5e-3)
-    assert solver in engine.FIRST_SAME_AS_LAST_SOLVERS
-    skipping = simulate(scene, 1.5, settings)
-    monkeypatch.setattr(engine, "FIRST_SAME_AS_LAST_SOLVERS", ())
-    assert_results_identical(skipping, simulate(scene, 1.5, settings))
-
-
-def test_other_solvers_keep_exudyns_end_of_step_accelerations():
-    """RK44's last stage is not the end-of-step state: Exudyn evaluates the accelerations after each step."""
-    from mbs_models.engine.accuracy import solver_settings_for
-    from mbs_models.engine.simulation import exudyn_simulation_settings
-
-    fixed = exudyn_simulation_settings(SolverSettings(solver="RK44", step=1e-4), 1.0)
-    assert fixed.timeIntegration.explicit.computeEndOfStepAccelerations
-    standard = exudyn_simulation_settings(solver_settings_for("standard"), 1.0)
-    assert not standard.timeIntegration.explicit.computeEndOfStepAccelerations
 
 
 # ------------------------------------------------------------------ bounds (issue #20): every run ends
@@ -236,7 +202,7 @@ def _contact_free_scenes():
 def test_the_budget_of_a_scene_without_contact_changes_no_result(scene, monkeypatch, assert_results_identical):
     """Every adaptive solve now counts its steps in a pre-step function; without it (as before issue #20) every
     contact-free shipped scene gives the same Result, bit for bit."""
-    import mbs_models.engine.simulation as engine
+    import mbs_models.engine.run_policy as engine
 
     budgeted = simulate(scene, 3.0)
     assert budgeted.steps > 0
@@ -249,7 +215,7 @@ def test_a_scene_without_contact_is_stopped_by_the_step_budget_naming_its_stiff_
     """The budget bounds contact-free solves too (a stiff spring the up-front check lets through, a budget of
     500 steps for the 2000 this run takes); the message names what is fast."""
     import mbs_models.engine.guard as guard
-    import mbs_models.engine.simulation as engine
+    import mbs_models.engine.run_policy as engine
     from mbs_models.scene.overrides import apply_overrides
 
     monkeypatch.setattr(guard, "MINIMUM_STEP_BUDGET", 500)
@@ -282,71 +248,6 @@ def test_a_fixed_step_run_with_many_sensors_is_thinned_to_the_cap(monkeypatch):
     monkeypatch.setattr(guard, "MAX_STORED_VALUES", 3 * 500)  # the simplified model: three sensors
     result = simulate(simplified_model(), 2.0, SolverSettings(solver="RK44", step=1e-3))  # 2000 steps
     assert len(result.time) <= 501 and result.time[-1] == pytest.approx(2.0)
-
-
-def test_ctrl_c_during_a_solve_is_a_keyboard_interrupt_not_a_failed_solve(monkeypatch):
-    """Exudyn reports an interrupt inside the solve as its own error; simulate raises KeyboardInterrupt."""
-    import mbs_models.engine.simulation as engine
-
-    original = engine._pre_step_function
-
-    def interrupted_after_50_steps(*args):
-        function, calls = original(*args), []
-
-        def pre_step(mbs, t):
-            calls.append(t)
-            if len(calls) == 50:
-                raise KeyboardInterrupt
-            return function(mbs, t)
-
-        pre_step.new_solve = function.new_solve
-        return pre_step
-
-    monkeypatch.setattr(engine, "_pre_step_function", interrupted_after_50_steps)
-    for scene in (simplified_model(), model_ii(1000.0, 0.0)):
-        with pytest.raises(KeyboardInterrupt):
-            simulate(scene, 1.0)
-
-
-def test_an_error_caused_by_an_interrupt_is_recognised_down_its_chain():
-    from mbs_models.engine.simulation import _interrupted
-
-    try:
-        try:
-            raise KeyboardInterrupt
-        except KeyboardInterrupt as interrupt:
-            raise SystemError("returned a result with an exception set") from interrupt
-    except SystemError as error:
-        assert _interrupted(error)
-    assert not _interrupted(RuntimeError("a user function failed"))
-
-
-def test_too_many_absorbers_are_refused_before_anything_else(tmp_path, recwarn):
-    from mbs_models import load_scene
-    from mbs_models.engine.simulation import MAX_ABSORBERS
-
-    absorbers = "".join(f'[[absorber]]\nname = "a{i}"\nmass = 10.0\nmount = "ground"\nstiffness = 8100.0\n'
-                        f'damping = 2205.0\n[absorber.contact]\ngap = 5.0\nstiffness = 2.1e8\nexponent = 1.3\n'
-                        f'damping_factor = 0.6\n' for i in range(MAX_ABSORBERS + 1))
-    (tmp_path / "many.toml").write_text('version = 2\n[barrel]\nmass = 5600.0\n[firing]\nprojectile_mass = 6.86\n'
-                                        'muzzle_velocity = 564.0\n[recoil_spring]\nstiffness = 27500.0\n' + absorbers)
-    scene = load_scene(tmp_path / "many.toml")
-    with pytest.raises(SceneError) as info:
-        simulate(scene, 1.0)
-    assert info.value.key == "absorber" and f"{MAX_ABSORBERS + 1} absorbers" in info.value.message
-    assert not recwarn.list  # refused before the unit-slip warnings (5 m gaps never close) are worked out
-
-
-@pytest.mark.parametrize("name, key", [("breech_pulse", "firing.pulse.times"), ("burst", "burst.shots")])
-def test_a_run_split_into_too_many_segments_is_refused_naming_the_key(name, key, monkeypatch):
-    import mbs_models.engine.simulation as engine
-    from mbs_models import load_scene
-    from mbs_models.scenes import scene_path
-
-    monkeypatch.setattr(engine, "MAX_SEGMENTS", 2)  # the pulse has 4 points, the burst 3 shots
-    with pytest.raises(SceneError) as info:
-        simulate(load_scene(scene_path(name)), 3.0)
-    assert info.value.key == key and "segments" in info.value.message
 
 
 @pytest.mark.parametrize("key, value", [("recoil_brake.discharge_coefficient", 1e-30),
@@ -407,28 +308,3 @@ def test_every_reported_extreme_ends_within_a_bound(name, key, value):
         except (SceneError, SimulationError) as error:
             assert str(error).strip() and "\n" not in str(error)
     assert time.perf_counter() - start < 60.0
-
-
-def test_solves_run_with_exudyns_throw_on_ctrl_c_and_restore_it(monkeypatch):
-    """Exudyn's default (False) only asks a solve to stop after its current step, which a step rejected for ever at
-    the minimum step size never ends (DESIGN.md, Exudyn notes); the engine's solves throw at once."""
-    import exudyn
-
-    import mbs_models.engine.simulation as engine
-
-    original, seen = engine._pre_step_function, []
-
-    def spying(*args):
-        function = original(*args)
-
-        def pre_step(mbs, t):
-            seen.append(exudyn.special.solver.throwErrorWithCtrlC)
-            return function(mbs, t)
-
-        pre_step.new_solve = function.new_solve
-        return pre_step
-
-    monkeypatch.setattr(engine, "_pre_step_function", spying)
-    before = exudyn.special.solver.throwErrorWithCtrlC
-    simulate(simplified_model(), 0.5)
-    assert seen and all(seen) and exudyn.special.solver.throwErrorWithCtrlC == before

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from mbs_models import load_scene, model_ii, simulate
-from mbs_models.engine import simulation
+from mbs_models.engine import result_builder
 from mbs_models.results import refinement
 from mbs_models.results.refinement import Episodes, refine
 from mbs_models.results.samples import Interpolant
@@ -17,17 +17,17 @@ from mbs_models.scenes import list_scenes, scene_path
 def solved(scene, end_time):
     """The mechanism and samples ``simulate`` hands to the post-processing."""
     seen = {}
-    original = simulation.analyse
+    original = result_builder.analyse
 
     def spy(mechanism, samples, *args, **kwargs):
         seen.update(mechanism=mechanism, samples=samples)
         return original(mechanism, samples, *args, **kwargs)
 
-    simulation.analyse = spy
+    result_builder.analyse = spy
     try:
         simulate(scene, end_time, "standard")
     finally:
-        simulation.analyse = original
+        result_builder.analyse = original
     return seen["mechanism"], seen["samples"]
 
 

@@ -50,3 +50,27 @@ def test_a_run_at_rest_says_when_in_its_summary_and_metrics():
     assert not rested.maxima_at_end_of_window()
     short = simulate(simplified_model(), 2.0, "draft")
     assert short.rest_note() is None and "rest_time" not in short.metrics() and "at rest" not in short.summary()
+
+
+def test_a_result_is_immutable_and_a_changed_copy_is_a_new_result():
+    """Built once (issue #21): no attribute can be assigned after construction, neither the run's fields nor a
+    contact's output; ``dataclasses.replace`` gives a copy and leaves the original as it was."""
+    import dataclasses
+
+    import pytest
+
+    from mbs_models import StopReason
+
+    result = simulate(model_ii(1000.0, 0.0), 0.3, "draft")
+    assert result.stop_reason is StopReason.END_TIME and result.requested_end_time == result.end_time == 0.3
+    for name, value in (("stop_reason", "metrics_final"), ("end_time", 0.1), ("max_barrel_displacement", 0.0),
+                        ("wall_time", 0.0), ("final_metrics", ())):
+        with pytest.raises(dataclasses.FrozenInstanceError):
+            setattr(result, name, value)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        result.contacts["contact"].peak_force = None
+    longer = dataclasses.replace(result, requested_end_time=2.0)
+    assert longer.requested_end_time == 2.0 and result.requested_end_time == 0.3
+    assert dataclasses.replace(result, stop_reason="at_rest").stop_reason is StopReason.AT_REST  # read from its text
+    with pytest.raises(ValueError):
+        dataclasses.replace(result, stop_reason="stopped")

@@ -21,6 +21,7 @@ def test_row_equals_a_single_simulate_run():
         assert row[name] == getattr(result, name), name
     assert row["impacts"] == len(result.impacts)
     assert row["end_time"] == result.end_time and row["steps"] == result.steps
+    assert type(row["stop_reason"]) is str and row["stop_reason"] == "end_time"  # plain text, as tables always held
     assert row["initial_velocity"] == result.scene.initial_velocity
     assert row["status"] == "ok" and row["error"] is None and row["wall_time"] > 0
     assert list(row) == ["absorber.mass", "contact.gap", *metric_columns(model_ii()), "wall_time", "status", "error"]

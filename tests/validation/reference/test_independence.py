@@ -2,44 +2,18 @@
 
 from __future__ import annotations
 
-import ast
 import json
 import os
 import subprocess
 import sys
-from pathlib import Path
 
+from imports import REPO, imports_of
 from mbs_models.scene import Absorber, Barrel, Contact, Firing, RecoilDamper, RecoilSpring, Scene, scene_to_toml
 
-REPO = Path(__file__).resolve().parents[3]
 PACKAGE = REPO / "validation" / "reference"
 #: third-party distributions the reference may use; besides these only the standard library and itself
 ALLOWED_THIRD_PARTY = {"numpy", "scipy"}
 OWN = "validation.reference"
-
-
-def _module_name(path: Path) -> str:
-    parts = path.relative_to(REPO).with_suffix("").parts
-    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
-
-
-def imports_of(path: Path) -> list[tuple[int, str]]:
-    """(line, absolute module name) of every import statement in ``path`` (relative ones resolved)."""
-    tree = ast.parse(path.read_text(), filename=str(path))
-    package = _module_name(path) if path.name == "__init__.py" else _module_name(path).rpartition(".")[0]
-    found = []
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Import):
-            found += [(node.lineno, alias.name) for alias in node.names]
-        elif isinstance(node, ast.ImportFrom):
-            if node.level:
-                base = package.split(".")
-                base = base[:len(base) - (node.level - 1)]
-                module = ".".join(base + ([node.module] if node.module else []))
-            else:
-                module = node.module
-            found.append((node.lineno, module))
-    return found
 
 
 def allowed(module: str) -> bool:
