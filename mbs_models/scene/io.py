@@ -117,6 +117,10 @@ def scene_from_dict(data: dict[str, Any]) -> Scene:
             raise SceneError(table, f"[{table}] needs a version-{cls.SINCE_VERSION} scene "
                                     f"(put version = {cls.SINCE_VERSION} at the top)")
         if cls.MANY:
+            if table != "absorber":  # an array of tables: [[table]] (one table [table] is an array of one)
+                entries = data[table] if isinstance(data[table], list) else [data[table]]
+                tables[table + "s"] = tuple(cls.from_mapping(entry, table if len(entries) == 1 else f"{table}.{i}",
+                                                             version) for i, entry in enumerate(entries))
             continue
         tables[table] = cls.from_mapping(data[table], table, version)
     absorbers = [ELEMENT_TABLES["absorber"].from_mapping(content, key, version)
