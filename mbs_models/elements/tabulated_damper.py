@@ -55,7 +55,7 @@ class TabulatedDamper(Table):
     file: str | None = None
     TABLE: ClassVar[str] = "tabulated_damper"
     MANY: ClassVar[bool] = True
-    ORDER: ClassVar[int] = 31
+    ORDER: ClassVar[int] = 45
     SINCE_VERSION: ClassVar[int] = 2
 
     def __post_init__(self):

@@ -65,7 +65,7 @@ class TabulatedSpring(Table):
     file: str | None = None
     TABLE: ClassVar[str] = "tabulated_spring"
     MANY: ClassVar[bool] = True
-    ORDER: ClassVar[int] = 21
+    ORDER: ClassVar[int] = 44
     SINCE_VERSION: ClassVar[int] = 2
 
     def __post_init__(self):

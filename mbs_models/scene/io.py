@@ -73,10 +73,10 @@ def version_2_tables(data: dict) -> list[tuple[str, str]]:
         cls = ELEMENT_TABLES.get(table)
         if cls is None:
             continue
-        if cls.SINCE_VERSION > 1:
-            found.append((table, f"[{table}]"))
         if isinstance(content, list):
             found.append((table, f"[[{table}]]"))
+        elif cls.SINCE_VERSION > 1:
+            found.append((table, f"[{table}]"))
         for entry in content if isinstance(content, list) else [content]:
             if not isinstance(entry, dict):
                 continue
