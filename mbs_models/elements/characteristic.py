@@ -206,9 +206,10 @@ def check_name(key: str, name) -> str:
 def check_unique_name(scene, table, key: str) -> None:
     """SceneError naming ``key.name`` if another element, body or connector of ``scene`` has the same name
     (outputs and energies are keyed by it)."""
-    taken = []
+    taken, passed = [], False
     for element, other in scene.elements():
-        if other is table:
+        passed = passed or other is table
+        if other is table or (passed and type(other) is type(table)):  # a later one of its kind names itself
             continue
         taken.append(element)
         taken += [b.name for b in other.bodies(scene, element)] + [c.name for c in other.connectors(scene, element)]
