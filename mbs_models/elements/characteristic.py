@@ -192,6 +192,15 @@ def warn_outside(characteristic: Characteristic, values, key: str, what: str, un
                       f"extrapolated linearly; extend the table", TableRangeWarning, stacklevel=3)
 
 
+def implausible_extent(characteristic: Characteristic, key: str, limit: float, what: str, unit: str,
+                       slip: str) -> list[tuple[str, str]]:
+    """``[(key, one line)]`` if the table reaches beyond ``|s| = limit`` (a unit slip, ``slip``), else []."""
+    extent = max(abs(characteristic.low), abs(characteristic.high))
+    if extent <= limit:
+        return []
+    return [(key, f"{key} reaches a {what} of {extent:g} {unit} (plausible: up to {limit:g} {unit}); {slip}")]
+
+
 def check_name(key: str, name) -> str:
     """A tabulated element's ``name``: an identifier (a letter, then letters, digits or ``_``), not ``barrel`` or
     ``ground``."""

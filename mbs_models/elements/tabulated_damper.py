@@ -19,7 +19,8 @@ would inject energy); the end segments' slopes are >= 0, so that the extrapolati
 every segment is passive (its ends are on the same side of v = 0, or one is the rest point).
 
 **Bounds**: ``|F| <= max |F|`` over ``|v| <= v_max`` (at the ends or a point inside).  The stability checks
-linearise it with its steepest segment (N s/m).
+linearise it with its steepest segment (N s/m).  A table reaching beyond 100 m/s (:data:`MAX_VELOCITY`) gets a
+UnitWarning naming the key (velocities in mm/s?).
 """
 
 from __future__ import annotations
@@ -29,12 +30,15 @@ from typing import Any, ClassVar
 
 from ..errors import SceneError
 from .barrel import BARREL
-from .characteristic import (Characteristic, check_name, check_unique_name, resolve_points, scene_key,
-                             warn_outside)
+from .characteristic import (Characteristic, check_name, check_unique_name, implausible_extent, resolve_points,
+                             scene_key, warn_outside)
 from .connector import GROUND, Connector
 from .ops import NUMPY_OPS, Ops
 from .table import Table
 
+#: The fastest plausible velocity (m/s) a damper table reaches: free-recoil velocities stay below 30 m/s
+#: (DESIGN.md "Unit slips"); a table in mm/s reaches 1000 times further.
+MAX_VELOCITY = 100.0
 #: The units of a point.
 UNITS = ("velocity m/s", "force N")
 
@@ -98,6 +102,12 @@ class TabulatedDamper(Table):
 
     def check_in_scene(self, scene, key: str) -> None:
         check_unique_name(scene, self, key)
+
+    def implausible(self, key: str) -> list[tuple[str, str]]:
+        """A table reaching beyond MAX_VELOCITY (a UnitWarning: ``mbs_models.scene.plausibility``)."""
+        where = f"{key}.file" if self.file is not None else f"{key}.points"
+        return implausible_extent(Characteristic(self.pairs), where, MAX_VELOCITY, "velocity", "m/s",
+                                  "velocities in mm/s?")
 
     def bodies(self, scene, name: str) -> list:
         return []

@@ -28,8 +28,8 @@ and an absorber would leave the early stop without its potential well: not suppo
 **Bounds**: ``|F| <= max |F|`` over ``|x| <= x_max`` (at the ends or a point inside; F is monotone); the early
 stop bounds x from the potential well this spring forms with the barrel's stops
 (:mod:`mbs_models.engine.final_metrics`: ``quadratic_potential`` is False).  The stability checks linearise it
-with its steepest segment.  A force beyond 1e7 N or a displacement beyond 10 m in the table is a UnitWarning
-(a table in kN or mm).
+with its steepest segment.  A table reaching beyond 5 m (:data:`MAX_STROKE`) gets a UnitWarning naming the key
+(displacements in mm?).
 """
 
 from __future__ import annotations
@@ -39,12 +39,15 @@ from typing import Any, ClassVar
 
 from ..errors import SceneError
 from .barrel import BARREL
-from .characteristic import (Characteristic, check_name, check_unique_name, resolve_points, scene_key,
-                             warn_outside)
+from .characteristic import (Characteristic, check_name, check_unique_name, implausible_extent, resolve_points,
+                             scene_key, warn_outside)
 from .connector import GROUND, Connector
 from .ops import Ops
 from .table import Table
 
+#: The longest plausible stroke (m) a spring table reaches: real recoil strokes are below 1.5 m; a table in mm
+#: reaches 1000 times further.
+MAX_STROKE = 5.0
 #: The units of a point.
 UNITS = ("displacement m", "force N")
 
@@ -101,6 +104,12 @@ class TabulatedSpring(Table):
 
     def check_in_scene(self, scene, key: str) -> None:
         check_unique_name(scene, self, key)
+
+    def implausible(self, key: str) -> list[tuple[str, str]]:
+        """A table reaching beyond MAX_STROKE (a UnitWarning: ``mbs_models.scene.plausibility``)."""
+        where = f"{key}.file" if self.file is not None else f"{key}.points"
+        return implausible_extent(Characteristic(self.pairs), where, MAX_STROKE, "displacement", "m",
+                                  "displacements in mm?")
 
     def bodies(self, scene, name: str) -> list:
         return []

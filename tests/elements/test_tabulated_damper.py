@@ -198,3 +198,10 @@ def test_a_run_that_leaves_the_table_says_so():
     with warnings.catch_warnings():
         warnings.simplefilter("error", TableRangeWarning)
         simulate(SHIPPED, 3.0)  # the shipped table covers its run
+
+
+def test_a_table_in_mm_per_s_gets_a_unit_warning():
+    from mbs_models import UnitWarning
+    in_mm = scene_with(TabulatedDamper("mm", ((-1000.0, -6239.0), (0.0, 0.0), (1000.0, 6239.0))))
+    with pytest.warns(UnitWarning, match=r"tabulated_damper.points reaches a velocity of 1000 m/s .*in mm/s\?"):
+        simulate(in_mm, 0.5)

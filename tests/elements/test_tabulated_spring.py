@@ -277,3 +277,10 @@ def test_the_early_stop_agrees_with_the_full_run():
     assert early.stop_reason == "metrics_final" and early.time[-1] < 5.0
     assert early.max_barrel_displacement == pytest.approx(full.max_barrel_displacement, rel=1e-9)
     assert early.peak_support_force == pytest.approx(full.peak_support_force, rel=1e-9)
+
+
+def test_a_table_in_mm_gets_a_unit_warning():
+    from mbs_models import UnitWarning
+    in_mm = scene_with(TabulatedSpring("mm", ((0.0, 0.0), (100.0, 2750.0), (400.0, 17400.0))))
+    with pytest.warns(UnitWarning, match=r"tabulated_spring.points reaches a displacement of 400 m .*in mm\?"):
+        simulate(in_mm, 0.5)
