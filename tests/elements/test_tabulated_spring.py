@@ -284,3 +284,33 @@ def test_a_table_in_mm_gets_a_unit_warning():
     in_mm = scene_with(TabulatedSpring("mm", ((0.0, 0.0), (100.0, 2750.0), (400.0, 17400.0))))
     with pytest.warns(UnitWarning, match=r"tabulated_spring.points reaches a displacement of 400 m .*in mm\?"):
         simulate(in_mm, 0.5)
+
+
+def test_building_block_in_your_own_system():
+    """add_tabulated_spring between two markers of a system of one's own: a mass at v0 on the two-point table
+    (a linear spring k) oscillates as x = v0 / w sin(w t), w = sqrt(k / m)."""
+    import exudyn
+    from exudyn.itemInterface import MarkerNodeCoordinate, NodePointGround, SensorNode
+
+    from mbs_models import add_body, add_tabulated_spring
+    system = exudyn.SystemContainer()
+    mbs = system.AddSystem()
+    ground = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=mbs.AddNode(NodePointGround()), coordinate=0))
+    mass, v0 = 100.0, 0.5
+    node, marker = add_body(mbs, mass, v0)
+    connector = add_tabulated_spring(mbs, ground, marker, TabulatedSpring("k", ((0.0, 0.0), (1.0, K))))
+    sensor = mbs.AddSensor(SensorNode(nodeNumber=node, outputVariableType=exudyn.OutputVariableType.Coordinates,
+                                      storeInternal=True))
+    mbs.Assemble()
+    settings = exudyn.SimulationSettings()
+    ti = settings.timeIntegration
+    ti.endTime, ti.numberOfSteps, ti.automaticStepSize = 0.2, 100, True
+    ti.relativeTolerance, ti.absoluteTolerance, ti.verboseMode = 1e-10, 1e-12, 0
+    settings.solution.file.write = False
+    settings.solution.sensors.writePeriod = 0.0
+    mbs.SolveDynamic(settings, solverType=exudyn.DynamicSolverType.DOPRI5)
+    t, x = mbs.GetSensorStoredData(sensor).T
+    w = math.sqrt(K / mass)
+    np.testing.assert_allclose(x, v0 / w * np.sin(w * t), rtol=0, atol=1e-8)
+    assert connector.index is not None
+    system.Reset()
