@@ -205,3 +205,24 @@ def test_a_table_in_mm_per_s_gets_a_unit_warning():
     in_mm = scene_with(TabulatedDamper("mm", ((-1000.0, -6239.0), (0.0, 0.0), (1000.0, 6239.0))))
     with pytest.warns(UnitWarning, match=r"tabulated_damper.points reaches a velocity of 1000 m/s .*in mm/s\?"):
         simulate(in_mm, 0.5)
+
+
+def test_the_early_stop_agrees_with_the_full_run():
+    full = simulate(SHIPPED, 5.0)
+    early = simulate(SHIPPED, 5.0, stop_when_final=("max_barrel_displacement", "peak_support_force"))
+    assert early.stop_reason == "metrics_final" and early.time[-1] < 5.0
+    assert early.max_barrel_displacement == pytest.approx(full.max_barrel_displacement, rel=1e-9)
+    assert early.peak_support_force == pytest.approx(full.peak_support_force, rel=1e-9)
+
+
+def test_the_reference_term_follows_design():
+    """The reference's damper (validation/reference/terms/tabulated_damper.py) against DESIGN.md written out here:
+    its force on every piece and its bound."""
+    from validation.reference.terms.tabulated_damper import TabulatedDamper as ReferenceDamper
+    damper = ReferenceDamper("d", "ground", "barrel", MEASURED)
+    for v in (-2.0, -1.0, -0.7, -0.2, -0.05, 0.0, 0.1, 0.5, 1.2, 1.5, 3.0):
+        start, value, slope = damper.table.pieces[damper.table.piece_of(v)]
+        assert value + slope * (v - start) == pytest.approx(float(design_force(MEASURED, v)), rel=1e-13, abs=1e-9)
+        grid = np.linspace(-abs(v), abs(v), 4001)
+        assert damper.force_bound(0.0, abs(v), 0.0) == pytest.approx(np.max(np.abs(design_force(MEASURED, grid))),
+                                                                     rel=1e-12)

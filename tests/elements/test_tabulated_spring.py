@@ -271,9 +271,12 @@ def test_a_run_that_leaves_the_table_says_so():
         simulate(SHIPPED, 3.0)  # the shipped table covers its run
 
 
-def test_the_early_stop_agrees_with_the_full_run():
-    full = simulate(SHIPPED, 5.0)
-    early = simulate(SHIPPED, 5.0, stop_when_final=("max_barrel_displacement", "peak_support_force"))
+@pytest.mark.parametrize("name", ["shipped", "with stops"])
+def test_the_early_stop_agrees_with_the_full_run(name):
+    """The spring's potential well (alone, or with the barrel's stops) bounds the rest of the run: the early stop
+    proves the peaks final well before the end, with the full run's values."""
+    full = simulate(CASES[name], 5.0)
+    early = simulate(CASES[name], 5.0, stop_when_final=("max_barrel_displacement", "peak_support_force"))
     assert early.stop_reason == "metrics_final" and early.time[-1] < 5.0
     assert early.max_barrel_displacement == pytest.approx(full.max_barrel_displacement, rel=1e-9)
     assert early.peak_support_force == pytest.approx(full.peak_support_force, rel=1e-9)
@@ -314,3 +317,16 @@ def test_building_block_in_your_own_system():
     np.testing.assert_allclose(x, v0 / w * np.sin(w * t), rtol=0, atol=1e-8)
     assert connector.index is not None
     system.Reset()
+
+
+def test_the_reference_term_follows_design():
+    """The reference's spring (validation/reference/terms/tabulated_spring.py) against DESIGN.md written out here:
+    its force at rest and its potential (scipy's quadrature of the extended table)."""
+    from validation.reference.terms.tabulated_spring import TabulatedSpring as ReferenceSpring
+    spring = ReferenceSpring("s", "ground", "barrel", PROGRESSIVE)
+    for x in (-0.25, -0.1, -0.03, 0.0, 0.07, 0.2, 0.33, 0.4, 0.55):
+        expected, _ = quad(lambda s: float(design_force(PROGRESSIVE, s)), 0.0, x,
+                           points=[p[0] for p in PROGRESSIVE if min(0, x) < p[0] < max(0, x)], epsabs=1e-12)
+        assert spring.stored_energy(x) == pytest.approx(expected, rel=1e-12, abs=1e-9)
+        assert spring.static_force(x) == pytest.approx(float(design_force(PROGRESSIVE, x)), rel=1e-13, abs=1e-9)
+        assert spring.force_bound(abs(x), 0.0, 0.0) >= abs(float(design_force(PROGRESSIVE, -abs(x))))
