@@ -48,6 +48,8 @@ _LAZY = {
     "add_recoil_damper": ".elements.recoil_damper",
     "add_recoil_brake": ".elements.recoil_brake",
     "add_recuperator": ".elements.recuperator",
+    "add_tabulated_spring": ".elements.tabulated_spring",
+    "add_tabulated_damper": ".elements.tabulated_damper",
     "add_body": ".engine.assembly",
     "run_sweep": ".studies.sweep",           # a grid over dotted scene keys -> a pandas table (recoil sweep)
     "optimise": ".studies.optimise",         # the best design within bounds (recoil optimise)

@@ -225,8 +225,9 @@ def _shipped_scenes() -> list:
 
 
 def with_every_element(scene=None, without=(), **law):
-    """``scene`` (default: the shipped scene with the most absorbers) with every single (non-array) table of
-    the shipped example scenes that it lacks, each as the first shipped scene (by name) that has it gives it.
+    """``scene`` (default: the shipped scene with the most absorbers) with every table of the shipped example scenes
+    that it lacks (an array other than the absorbers, ``[[tabulated_spring]]``, as a whole), each as the first
+    shipped scene (by name) that has it gives it.
     The shipped examples together have every element table of the library (test_terms.py checks it), so the
     result is a scene of every element, composed without naming one.  ``law`` (e.g. ``law="hertz",
     stiffness=1e9, exponent=1.5``): every added table with a contact law takes that law and those fields.
@@ -244,21 +245,27 @@ def with_every_element(scene=None, without=(), **law):
     shipped = [s for s in _shipped_scenes() if not s.name.startswith("realistic")]
     scene = max(shipped, key=lambda s: len(s.absorbers)) if scene is None else scene
     added: dict = {}
+    table_of = {}  # the keyword of an array of tables (``tabulated_springs``) -> its table name
     for other in shipped:
         for key, table in other.tables():
-            if key in ELEMENT_TABLES and not ELEMENT_TABLES[key].MANY and getattr(scene, key) is None:
+            name = key.split(".")[0]
+            if name in ELEMENT_TABLES and not ELEMENT_TABLES[name].MANY and getattr(scene, key) is None:
                 added.setdefault(key, table)
+            elif name in ELEMENT_TABLES and ELEMENT_TABLES[name].MANY and name != "absorber" \
+                    and not getattr(scene, name + "s"):
+                added.setdefault(name + "s", getattr(other, name + "s"))  # an array other than the absorbers
+                table_of[name + "s"] = name
     if law:
         added = {key: replace(table, **{**dict.fromkeys(LAW_FIELDS), **law}) if isinstance(table, LawFields) else table
                  for key, table in added.items()}
     from mbs_models import SceneError
 
-    added = {key: table for key, table in added.items() if key not in without}
+    added = {key: table for key, table in added.items() if table_of.get(key, key) not in without}
     try:
         return scene.with_changes(**added)
     except SceneError:
         pass
-    for key in sorted(added, key=lambda k: -ELEMENT_TABLES[k].ORDER):  # leave one out, the last in order first
+    for key in sorted(added, key=lambda k: -ELEMENT_TABLES[table_of.get(k, k)].ORDER):  # leave one out, the last in order first
         try:
             return scene.with_changes(**{k: t for k, t in added.items() if k != key})
         except SceneError:

@@ -257,7 +257,7 @@ class Scene:
         for key, value in self._parts:
             if isinstance(value, tuple):
                 out += [(next(names), item) for item in value] if key == "absorbers" else \
-                    [(f"{key[:-1]}_{i + 1}", item) for i, item in enumerate(value)]
+                    [(getattr(item, "name", None) or f"{key[:-1]}_{i + 1}", item) for i, item in enumerate(value)]
             elif value is not None:
                 out.append((key, value))
         return out

@@ -73,10 +73,10 @@ def version_2_tables(data: dict) -> list[tuple[str, str]]:
         cls = ELEMENT_TABLES.get(table)
         if cls is None:
             continue
-        if cls.SINCE_VERSION > 1:
-            found.append((table, f"[{table}]"))
         if isinstance(content, list):
             found.append((table, f"[[{table}]]"))
+        elif cls.SINCE_VERSION > 1:
+            found.append((table, f"[{table}]"))
         for entry in content if isinstance(content, list) else [content]:
             if not isinstance(entry, dict):
                 continue
@@ -117,6 +117,10 @@ def scene_from_dict(data: dict[str, Any]) -> Scene:
             raise SceneError(table, f"[{table}] needs a version-{cls.SINCE_VERSION} scene "
                                     f"(put version = {cls.SINCE_VERSION} at the top)")
         if cls.MANY:
+            if table != "absorber":  # an array of tables: [[table]] (one table [table] is an array of one)
+                entries = data[table] if isinstance(data[table], list) else [data[table]]
+                tables[table + "s"] = tuple(cls.from_mapping(entry, table if len(entries) == 1 else f"{table}.{i}",
+                                                             version) for i, entry in enumerate(entries))
             continue
         tables[table] = cls.from_mapping(data[table], table, version)
     absorbers = [ELEMENT_TABLES["absorber"].from_mapping(content, key, version)

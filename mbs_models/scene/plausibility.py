@@ -107,7 +107,14 @@ def _pulse(scene: Scene) -> list[Implausible]:
 def implausible_magnitudes(scene: Scene) -> list[Implausible]:
     """Every implausible magnitude of ``scene`` (module docstring), barrel first, then the pulse; [] for a
     plausible scene."""
-    return _recoil_velocity(scene) + _pulse(scene)
+    return _recoil_velocity(scene) + _pulse(scene) + _tables(scene)
+
+
+def _tables(scene: Scene) -> list[Implausible]:
+    """The findings an element's table gives itself: ``table.implausible(key) -> [(key, text), ...]`` (the tabulated
+    characteristics: a table in mm or mm/s)."""
+    return [Implausible(key, text) for table_key, table in scene.tables() if hasattr(table, "implausible")
+            for key, text in table.implausible(table_key)]
 
 
 __all__ = ["Implausible", "implausible_magnitudes", "MAX_RECOIL_VELOCITY", "MAX_PULSE_DURATION", "IMPULSE_RATIO",

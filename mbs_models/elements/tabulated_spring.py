@@ -1,0 +1,176 @@
+"""A tabulated spring between the ground and the barrel: a measured force-displacement characteristic F(x).
+
+Tables (version 2; an array: several may act together, each with its own ``name``)::
+
+    [[tabulated_spring]]
+    name = "main_spring"                      # identifier: the key of its energy and outputs
+    points = [[0.0, 0.0], [0.1, 2400.0], [0.2, 5600.0], [0.3, 9600.0]]   # (displacement m, force N)
+    # file = "spring.csv"                     # or a CSV "displacement,force" beside the scene file
+
+**Law** (:mod:`.characteristic`): ``F(x)`` piecewise linear through the points, ``x = x_M`` the barrel's
+displacement (m), a connector ground -> barrel (``d = x_M``: ``F > 0`` pushes the barrel towards battery and
+the mount in the recoil direction).  Beyond the table the end segments are extrapolated linearly, and a run that
+leaves the table is told so (:class:`~.characteristic.TableRangeWarning` naming the key).  Stored energy,
+exact::
+
+    U(x) = integral_0^x F = C_i + F_i (x - x_i) + k_i (x - x_i)^2 / 2     (x in segment i, slope k_i)
+
+tangent stiffness ``k_i``; no dissipation.  A user function (symbolic by default).
+
+**Rules** (SceneError naming the key): at least 2 points, finite, displacements strictly increasing; the table
+lists the rest point ``(0, 0)`` (the barrel starts at rest at battery, x = 0, so the spring is relaxed there: a
+preloaded spring needs a battery stop to hold it, which this element does not model -- use a
+``[recuperator]`` for a preload); the force never decreases with x (``F_(i+1) >= F_i``: a spring whose force
+falls as it is compressed is unstable, and the energy bounds of the early stop need a convex potential).  So
+``U >= 0`` and convex, with ``U(0) = 0``.  Between the ground and the barrel only (a spring between the barrel
+and an absorber would leave the early stop without its potential well: not supported).
+
+**Bounds**: ``|F| <= max |F|`` over ``|x| <= x_max`` (at the ends or a point inside; F is monotone); the early
+stop bounds x from the potential well this spring forms with the barrel's stops
+(:mod:`mbs_models.engine.final_metrics`: ``quadratic_potential`` is False).  The stability checks linearise it
+with its steepest segment.  A table reaching beyond 5 m (:data:`MAX_STROKE`) gets a UnitWarning naming the key
+(displacements in mm?).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+from ..errors import SceneError
+from .barrel import BARREL
+from .characteristic import (Characteristic, check_name, check_unique_name, implausible_extent, resolve_points,
+                             scene_key, warn_outside)
+from .connector import GROUND, Connector
+from .ops import Ops
+from .table import Table
+
+#: The longest plausible stroke (m) a spring table reaches: real recoil strokes are below 1.5 m; a table in mm
+#: reaches 1000 times further.
+MAX_STROKE = 5.0
+#: The units of a point.
+UNITS = ("displacement m", "force N")
+
+
+@dataclass(frozen=True)
+class TabulatedSpring(Table):
+    """A spring ground -> barrel with a tabulated characteristic F(x) (module docstring).
+
+    Attributes
+    ----------
+    name: identifier of the element (its energy and outputs).
+    points: ``[[x m, F N], ...]``, at least 2, x strictly increasing, with the point (0, 0), F non-decreasing.
+    file: instead of ``points``, a CSV file ``displacement,force`` (one header line), relative to the scene file.
+    """
+
+    name: str
+    points: Any = None
+    file: str | None = None
+    TABLE: ClassVar[str] = "tabulated_spring"
+    MANY: ClassVar[bool] = True
+    ORDER: ClassVar[int] = 44
+    SINCE_VERSION: ClassVar[int] = 2
+
+    def __post_init__(self):
+        super().__post_init__()
+        key = self.TABLE
+        check_name(key, self.name)
+        pairs = resolve_points(self, key, "displacement,force", UNITS)
+        where = f"{key}.file" if self.file is not None else f"{key}.points"
+        if (0.0, 0.0) not in pairs:
+            raise SceneError(where, "must list the rest point [0.0, 0.0]: the barrel starts at rest at x = 0 m, "
+                                    "where the spring must be relaxed (a preload needs a [recuperator])")
+        for i in range(1, len(pairs)):
+            if pairs[i][1] < pairs[i - 1][1]:
+                item = where if self.file is not None else f"{where}.{i}"
+                raise SceneError(item, f"the force must not decrease with x (>= {pairs[i - 1][1]:g} N), got "
+                                       f"{pairs[i][1]:g} N at x = {pairs[i][0]:g} m")
+        if self.file is None:
+            object.__setattr__(self, "points", pairs)
+        object.__setattr__(self, "_pairs", pairs)
+
+    @property
+    def pairs(self) -> tuple[tuple[float, float], ...]:
+        """The points ``(x m, F N)`` as given inline or read from the file."""
+        return self._pairs
+
+    def to_mapping(self) -> dict[str, Any]:
+        out: dict[str, Any] = {"name": self.name}
+        if self.file is not None:
+            out["file"] = self.file
+        else:
+            out["points"] = [list(p) for p in self.pairs]
+        return out
+
+    def check_in_scene(self, scene, key: str) -> None:
+        check_unique_name(scene, self, key)
+
+    def implausible(self, key: str) -> list[tuple[str, str]]:
+        """A table reaching beyond MAX_STROKE (a UnitWarning: ``mbs_models.scene.plausibility``)."""
+        where = f"{key}.file" if self.file is not None else f"{key}.points"
+        return implausible_extent(Characteristic(self.pairs), where, MAX_STROKE, "displacement", "m",
+                                  "displacements in mm?")
+
+    def bodies(self, scene, name: str) -> list:
+        return []
+
+    def connectors(self, scene, name: str) -> list[Connector]:
+        return [TabulatedSpringConnector(self.name, name, self, scene_key(scene, self, self.TABLE))]
+
+
+class TabulatedSpringConnector(Connector):
+    """The tabulated spring as a connector ground -> barrel (d = x_M), a user function."""
+
+    needs_user_function = True
+    quadratic_potential = False
+
+    def __init__(self, name: str, element: str, spring: TabulatedSpring, key: str = TabulatedSpring.TABLE):
+        super().__init__(name, element, GROUND, BARREL)
+        self.spring, self.key = spring, key
+        self.characteristic = Characteristic(spring.pairs)
+
+    def law(self, d, rate, ops: Ops):
+        """F(d) (N) over ``ops``."""
+        return self.characteristic.law(d, ops)
+
+    def force(self, d, rate, t=None):
+        return self.characteristic.force(d) + 0.0 * rate
+
+    def python_force(self, d: float, rate: float) -> float:
+        return float(self.characteristic.force(d))
+
+    @property
+    def stores_energy(self) -> bool:
+        return True
+
+    @property
+    def dissipates(self) -> bool:
+        return False
+
+    def stored_energy(self, d):
+        """``U(d) = integral_0^d F`` (J), exact.  Given a run's samples (an array), a run that left the table gets
+        a :class:`~.characteristic.TableRangeWarning`."""
+        if getattr(d, "ndim", 0) >= 1 and getattr(d, "size", 0) > 1:
+            warn_outside(self.characteristic, d, self.key, "displacement", "m")
+        return self.characteristic.integral(d)
+
+    def python_stored_energy(self, d: float) -> float:
+        return float(self.characteristic.integral(d))
+
+    @property
+    def linear_stiffness(self) -> float:
+        """The steepest segment's slope (N/m): for the stability checks only (not a quadratic potential)."""
+        return self.characteristic.steepest_slope
+
+    def force_bound(self, d_bound: float, rate_bound: float, energy: float) -> float:
+        """``max |F|`` over ``|d| <= d_bound`` (N)."""
+        return self.characteristic.largest_magnitude(-d_bound, d_bound)
+
+
+def add_tabulated_spring(mbs, marker_ground, marker_barrel, spring: TabulatedSpring,
+                         user_functions: str = "symbolic") -> TabulatedSpringConnector:
+    """Add a tabulated spring F(d) between two coordinate markers of your own Exudyn system (``d`` the
+    displacement of the second marker from the first); returns the connector (``.index`` is the Exudyn item)."""
+    connector = TabulatedSpringConnector(spring.name, spring.name, spring)
+    connector.add_items(mbs, marker_ground, marker_barrel, user_functions)
+    return connector
