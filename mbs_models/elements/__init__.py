@@ -18,7 +18,7 @@ import importlib
 import inspect
 import pkgutil
 
-from .connector import GROUND, Body, Connector
+from .connector import GROUND, Body, Connector, LinearSpringDamper
 from .table import Rule, Table
 
 _INFRASTRUCTURE = {"connector", "ops", "table"}
@@ -46,4 +46,4 @@ TABLES: dict[str, type] = _discover()
 ELEMENT_TABLES: dict[str, type] = {name: cls for name, cls in TABLES.items()
                                    if not any(cls in other.NESTED.values() for other in TABLES.values())}
 
-__all__ = ["Body", "Connector", "GROUND", "Rule", "Table", "TABLES", "ELEMENT_TABLES"]
+__all__ = ["Body", "Connector", "LinearSpringDamper", "GROUND", "Rule", "Table", "TABLES", "ELEMENT_TABLES"]

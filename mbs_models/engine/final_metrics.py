@@ -155,7 +155,7 @@ class _QuadraticForm:
         n = len(mechanism.bodies)
         K = np.zeros((n, n))
         for connector in mechanism.connectors:
-            k = connector.linear_stiffness if connector.quadratic_potential else 0.0
+            k = connector.quadratic_stiffness if connector.quadratic_potential else 0.0
             if k > 0:
                 g = mechanism.direction(connector)
                 K += k * np.outer(g, g)
@@ -374,7 +374,7 @@ class EnergyBounds:
         #: other potentials); ``a``, ``b``: :func:`connector_ends`.
         self._energy_terms = tuple(
             (tuple((i, self._half_masses[i]) for i in kinetic),
-             tuple(connector_ends(mechanism, c) + (0.5 * c.stiffness,) for c in springs),
+             tuple(connector_ends(mechanism, c) + (0.5 * c.quadratic_stiffness,) for c in springs),
              tuple(connector_ends(mechanism, c) + (c.python_elastic,) for c in contacts)
              + tuple(connector_ends(mechanism, c) + (c.python_stored_energy,) for c in general))
             for kinetic, springs, contacts, general in self._groups if kinetic or springs or contacts or general)
@@ -404,14 +404,16 @@ class EnergyBounds:
 
     @staticmethod
     def _find_free_oscillators(mechanism: Mechanism) -> dict[int, tuple[list, list]]:
-        """Bodies tied to the ground by linear connectors only (besides contacts): index -> (their
-        connectors, their contacts)."""
+        """Bodies tied to the ground only, by connectors whose potential is a quadratic form or none (besides
+        contacts): index -> (their connectors, their contacts).  (A potential given as a function may be
+        negative: the body's own energy would then bound nothing.)"""
         out = {}
         for i, body in enumerate(mechanism.bodies):
             touching = [c for c in mechanism.connectors if body.name in (c.a, c.b)]
             contacts = [c for c in touching if c.is_contact]
             others = [c for c in touching if not c.is_contact]
-            if i > 0 and all(GROUND in (c.a, c.b) for c in others):
+            if i > 0 and all(GROUND in (c.a, c.b) and (c.quadratic_potential or not c.stores_energy)
+                             for c in others):
                 out[i] = (others, contacts)
         return out
 
@@ -484,7 +486,7 @@ class EnergyBounds:
         for c in connectors:
             if c.stores_energy:
                 d = m.relative_at(c, x)
-                energy += 0.5 * c.stiffness * d * d
+                energy += 0.5 * c.quadratic_stiffness * d * d
         return energy
 
     # ---------------------------------------------------------------------------- bounds

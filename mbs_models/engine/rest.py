@@ -99,8 +99,9 @@ class RestState:
         self.well = well
         self._x_r, self._gamma = float(rest_well_position), float(gamma)
         self._kinetic = tuple((i, 0.5 * body.mass) for i, body in enumerate(mechanism.bodies))
-        self._springs = tuple(connector_ends(mechanism, c) + (0.5 * c.linear_stiffness,) for c in mechanism.connectors
-                              if c.quadratic_potential and not c.is_contact and c.linear_stiffness > 0)
+        self._springs = tuple(connector_ends(mechanism, c) + (0.5 * c.quadratic_stiffness,)
+                              for c in mechanism.connectors
+                              if c.quadratic_potential and not c.is_contact and c.quadratic_stiffness > 0)
         self._elastic = tuple(connector_ends(mechanism, c) + (c.python_elastic,) for c in mechanism.contacts
                               if well is None or c not in well)
 
