@@ -216,7 +216,8 @@ class Connector(abc.ABC):
 
     def derived_stored_energy(self, d: float) -> float:
         """``U(d) = integral_0^d F(s, 0) ds`` (J) by adaptive Gauss-Kronrod quadrature (scipy's ``quad``, to a
-        relative 1e-12); 0 for a connector that stores none, inf outside :attr:`coordinate_range`."""
+        relative 1e-12) on the pieces between the :attr:`kinks`; 0 for a connector that stores none, inf outside
+        :attr:`coordinate_range`."""
         d = float(d)
         if not self.stores_energy or d == 0.0:
             return 0.0
@@ -225,17 +226,23 @@ class Connector(abc.ABC):
             return math.inf
         from scipy.integrate import quad
 
-        value, _ = quad(self.conservative_force, 0.0, d, epsabs=0.0, epsrel=1e-12, limit=200)
+        kinks = sorted(k for k in self.kinks if min(0.0, d) < k < max(0.0, d))
+        value = 0.0
+        for start, end in zip([0.0] + kinks if d > 0 else [0.0] + kinks[::-1], (kinks if d > 0 else kinks[::-1]) + [d]):
+            piece, _ = quad(self.conservative_force, start, end, epsabs=0.0, epsrel=1e-12, limit=200)
+            value += piece
         return float(value)
 
     def derived_stored_energy_array(self, d):
         """:meth:`derived_stored_energy` over an array of ``d`` (m) at once: the distinct values and 0 sorted,
-        ``F(s, 0)`` integrated between neighbours by 8-point Gauss-Legendre (exact for a polynomial force up
-        to degree 15) and summed outward from ``d = 0``."""
+        ``F(s, 0)`` integrated between neighbours (the :attr:`kinks` among them) by 8-point Gauss-Legendre (exact
+        for a polynomial force up to degree 15) and summed outward from ``d = 0``."""
         array = np.asarray(d, dtype=float)
         if not self.stores_energy:
             return np.zeros_like(array)
-        points, inverse = np.unique(np.append(array.ravel(), 0.0), return_inverse=True)
+        values = array.ravel()
+        kinks = [k for k in self.kinks if values.size and float(np.min(values)) < k < float(np.max(values))]
+        points, inverse = np.unique(np.concatenate((values, [0.0], kinks)), return_inverse=True)
         zero = int(np.searchsorted(points, 0.0))
         nodes, weights = np.polynomial.legendre.leggauss(8)
         left, right = points[:-1], points[1:]
@@ -243,14 +250,21 @@ class Connector(abc.ABC):
         s = (0.5 * (left + right))[:, None] + half[:, None] * nodes[None, :]
         forces = np.asarray(self.law(s, np.zeros_like(s), NUMPY_OPS), dtype=float) * np.ones_like(s)
         pieces = half * (forces @ weights)
-        cumulative = np.concatenate(([0.0], np.cumsum(pieces)))
-        energy = cumulative - cumulative[zero]
-        return energy[inverse[:-1]].reshape(array.shape)
+        energy = np.zeros(points.size)  # summed outward from 0 on each side (no cancellation near d = 0)
+        energy[zero + 1:] = np.cumsum(pieces[zero:])
+        energy[:zero] = -np.cumsum(pieces[:zero][::-1])[::-1]
+        return energy[inverse[:values.size]].reshape(array.shape)
 
     @property
     def coordinate_range(self) -> tuple[float, float]:
         """(lowest, highest) d in m where the law is defined (all of it, but for a gas spring's singularity)."""
         return -math.inf, math.inf
+
+    @property
+    def kinks(self) -> tuple[float, ...]:
+        """The d (m) where ``F(d, 0)`` or its slope jumps (a contact's offset): the derived stored energy
+        integrates piece by piece between them.  None for a smooth law (the default)."""
+        return ()
 
     def dissipated_energy(self, quadrature: Quadrature, d_nodes, rate_nodes, times_nodes, stored):
         """Cumulative dissipated energy (J) at the output samples: ``(F(d, d') - F(d, 0)) d'`` integrated.
