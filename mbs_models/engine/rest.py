@@ -111,7 +111,10 @@ class RestState:
         (module docstring).  ``bounds``: the scene's :class:`EnergyBounds` if at hand (its potential well)."""
         if not dissipative(mechanism) or any(c.sticks for c in mechanism.connectors):
             return None
-        well = (bounds or EnergyBounds(mechanism)).well
+        bounds = bounds or EnergyBounds(mechanism)
+        if bounds.loose:  # a potential given as a function outside the well: its rest state is not modelled here
+            return None
+        well = bounds.well
         n = len(mechanism.bodies)
         form = _QuadraticForm(mechanism)
         null = form.null_space()
