@@ -16,9 +16,10 @@ force.  From these two definitions everything generic follows and is written onc
 
 * the force on the ground, positive in the recoil direction: ``+F`` if ``a`` is the ground, ``-F`` if
   ``b`` is (:attr:`Connector.support_sign`); the support force is their sum;
-* stored energy ``U(d)`` and dissipated power; their integrals close the energy balance per connector;
-* the linear stiffness of springs (the quadratic form behind the energy bounds of the early stop) and
-  the force bounds of each connector given bounds on ``d`` and ``d'``.
+* stored energy ``U(d) = integral_0^d F(s, 0) ds`` and dissipated power ``(F(d, d') - F(d, 0)) d'``; their
+  integrals close the energy balance per connector;
+* each connector's share of the energy bounds of the early stop (a quadratic potential's stiffness, or
+  its potential as a function) and its force bound given bounds on ``d`` and ``d'``.
 
 Element modules subclass :class:`Connector` with a law of their own (the asymmetric recoil damper, the
 contact laws) -- the law is the one mandatory part, the rest is derived from it (see :class:`Connector`) --
