@@ -67,6 +67,15 @@ def on_register(callback) -> None:
     _LISTENERS.append(callback)
 
 
+def _same_definition(old: type, new: type) -> bool:
+    """True when ``new`` is ``old`` defined again: the same class name in the same source file (a user module
+    imported a second time, under another name or reloaded)."""
+    try:
+        return old.__qualname__ == new.__qualname__ and inspect.getsourcefile(old) == inspect.getsourcefile(new)
+    except TypeError:  # a class without a source file (built in, or made at run time)
+        return False
+
+
 def register_element(table_class: type) -> type:
     """Register an element defined outside this package: its scene table ``table_class`` (a frozen dataclass
     subclass of :class:`Table` with ``TABLE``, ``ORDER``, ``RULES``, ``bodies`` and ``connectors``); returns it
@@ -75,7 +84,9 @@ def register_element(table_class: type) -> type:
     Afterwards ``[TABLE]`` is a scene table like the shipped ones: in scene files, :class:`~mbs_models.Scene`
     keywords, dotted override keys of sweeps and the optimiser, :func:`~mbs_models.simulate` and the CLI
     (``recoil --plugin MODULE run ...`` imports a module that calls this).  Registering the same class again
-    does nothing; another class under a name already taken, or a class that is not a Table, is a TypeError.
+    does nothing, and the same definition imported again (its module reloaded, or imported under a second
+    name) replaces the first; another class under a name already taken, or a class that is not a Table, is a
+    TypeError.
     Its reference term is registered on the reference's side
     (:func:`validation.reference.terms.register_term`).  Processes forked afterwards (the sweep's local
     workers) inherit the registration; a Dask worker must import the module itself.
@@ -89,6 +100,8 @@ def register_element(table_class: type) -> type:
         raise TypeError(f"{table_class.__name__}.TABLE must name its TOML table (an identifier), got {name!r}")
     if TABLES.get(name) is table_class:
         return table_class
+    if name in TABLES and _same_definition(TABLES[name], table_class):  # its module imported again (reloaded)
+        del TABLES[name]
     if name in TABLES or name in ("conventions", "name", "version", "contact"):
         taken = TABLES.get(name, "a scene key")
         raise TypeError(f"the table name {name!r} of {table_class.__name__} is taken by {taken}")

@@ -119,3 +119,20 @@ def test_a_plugin_that_cannot_be_imported_is_one_line_of_bad_input():
     assert done.stderr.strip().splitlines() == [
         "recoil: error: --plugin: cannot import 'no_such_plugin_module': ModuleNotFoundError: No module named "
         "'no_such_plugin_module'"]
+
+
+def test_the_module_imported_twice_registers_its_second_definition():
+    """``--plugin path.py`` and an ``import`` of the same file give two class objects of one definition: the
+    second replaces the first on both sides (no "name taken" error), and scenes use the one imported last."""
+    script = ("import sys\nfrom mbs_models.cli.plugins import load_plugins\n"
+              f"load_plugins([{str(EXAMPLE)!r}])\n"
+              f"sys.path.insert(0, {str(EXAMPLE.parent)!r})\n"
+              "import progressive_spring\n"
+              "from mbs_models import load_scene\n"
+              "from mbs_models.elements import TABLES\n"
+              "from validation.reference.terms import TERMS\n"
+              f"scene = load_scene({str(SCENE)!r})\n"
+              "print(TABLES['progressive_spring'] is progressive_spring.ProgressiveSpring,\n"
+              "      TERMS['progressive_spring'] is progressive_spring.ReferenceTerm,\n"
+              "      type(scene.progressive_spring) is progressive_spring.ProgressiveSpring)\n")
+    assert _run(["-c", script]).split() == ["True", "True", "True"]

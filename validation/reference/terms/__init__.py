@@ -41,14 +41,28 @@ def _discover() -> dict[str, ModuleType]:
 TERMS: dict[str, ModuleType] = _discover()
 
 
+def _redefined(old, new) -> bool:
+    """Is ``new`` the term ``old`` once more: the same name from the same file (its module imported again)?"""
+    import inspect
+
+    def origin(term):
+        try:
+            return getattr(term, "__qualname__", getattr(term, "__name__", None)), inspect.getfile(term)
+        except TypeError:
+            return None, id(term)
+
+    return origin(old) == origin(new)
+
+
 def register_term(term) -> object:
     """Register the reference term of an element defined outside the package; returns ``term``.
 
     ``term`` is a module (or any object) with ``TABLES`` (the scene table names it models) and
     ``build(builder, key, table)`` (adds its bodies and connectors, subclasses of
     :class:`validation.reference.model.Connector`, to the builder), exactly like the term modules of this
-    package.  Registering the same term again does nothing; a table that already has another term, or a term
-    without ``TABLES`` or ``build``, is a TypeError.  The engine's side is
+    package.  Registering the same term again does nothing, and the same definition imported again (its module
+    reloaded) replaces the first; a table that already has another term, or a term without ``TABLES`` or
+    ``build``, is a TypeError.  The engine's side is
     :func:`mbs_models.register_element`.
     """
     tables = getattr(term, "TABLES", None)
@@ -56,7 +70,7 @@ def register_term(term) -> object:
         raise TypeError(f"a reference term needs TABLES (a tuple of table names) and build(builder, key, table): "
                         f"{term!r}")
     for table in tables:
-        if TERMS.get(table, term) is not term:
+        if TERMS.get(table, term) is not term and not _redefined(TERMS[table], term):
             raise TypeError(f"[{table}] already has a reference term: {TERMS[table].__name__}")
     for table in tables:
         TERMS[table] = term
