@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import importlib
 
+from .elements import register_element
 from .errors import ClusterError, RecoilError, SceneError, SimulationError, UnitWarning
 from .scene import (TABLE_CLASSES, Conventions, Scene, apply_overrides, load_scene, model_i, model_ii, paper_model,
                     parse_spec, scene_from_dict, scene_to_dict, scene_to_toml, simplified_model)
@@ -56,7 +57,7 @@ _LAZY = {
 }
 
 __all__ = [
-    *TABLE_CLASSES, "Conventions", "Scene", "StopReason",
+    *TABLE_CLASSES, "Conventions", "Scene", "StopReason", "register_element",
     "RecoilError", "SceneError", "SimulationError", "ClusterError", "UnitWarning",
     "load_scene", "scene_from_dict", "scene_to_dict", "scene_to_toml", "apply_overrides", "parse_spec",
     "model_i", "model_ii", "paper_model", "simplified_model",

@@ -22,6 +22,7 @@ from .. import __version__
 from ..errors import ClusterError, SceneError, SimulationError, UnitWarning
 from ..scene import load_scene
 from . import run
+from .plugins import add_plugin_argument, load_plugins
 from .sweep import add_set_argument, add_sweep_parser, apply_sets
 
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
@@ -207,6 +208,7 @@ def _cmd_design_brake(args) -> int:
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="recoil", description="Recoil mechanisms with impact absorbers (Exudyn).")
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    add_plugin_argument(parser)
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     run.add_parser(sub, ACCURACY_HELP)
@@ -310,6 +312,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 def _main(argv: Sequence[str] | None) -> int:
     try:
         args = build_parser().parse_args(argv)
+        load_plugins(args.plugin)
         return args.handler(args)
     except SceneError as exc:
         key = _ARGUMENT_NAMES.get(exc.key, exc.key)

@@ -33,7 +33,7 @@ from typing import ClassVar
 
 from ..errors import SceneError
 from .barrel import BARREL
-from .connector import GROUND, Body, Connector
+from .connector import GROUND, Body, Connector, LinearSpringDamper
 from .contact_laws import Contact, ContactConnector
 from .table import Rule, Table, check_choice, check_derived, ieee_power
 
@@ -117,7 +117,7 @@ class Absorber(Table):
         out: list[Connector] = []
         if self.stiffness > 0 or self.damping > 0:
             mount = BARREL if self.mount == "barrel" else GROUND
-            out.append(Connector(actuator, name, mount, name, stiffness=self.stiffness, damping=self.damping))
+            out.append(LinearSpringDamper(actuator, name, mount, name, stiffness=self.stiffness, damping=self.damping))
         gap = self.contact.gap
         offset = -gap if scene.conventions.literal_gap_sign else gap
         out.append(ContactConnector(contact, name, name, BARREL, self.contact, offset, conventions=scene.conventions))

@@ -120,9 +120,9 @@ class Characteristic:
         self.s = np.array([p[0] for p in self.points])
         self.f = np.array([p[1] for p in self.points])
         self.slopes = np.diff(self.f) / np.diff(self.s)
-        # C_i = integral_0^(s_i) F: trapezoids from the segment holding 0 (exact for a linear F)
-        cumulative = np.concatenate([[0.0], np.cumsum(0.5 * (self.f[1:] + self.f[:-1]) * np.diff(self.s))])
-        self.integral_at_points = cumulative - float(self._integral_from_first(0.0, cumulative))
+        # C_i = integral_0^(s_i) F, summed outward from 0 (exact for a linear F; no difference of two large
+        # integrals from the table's first point, whose round-off would swamp U near 0)
+        self.integral_at_points = np.array([self._from_zero(float(p)) for p in self.s])
 
     @property
     def low(self) -> float:
@@ -135,10 +135,23 @@ class Characteristic:
     def _segment(self, s):
         return np.clip(np.searchsorted(self.s, s, side="right") - 1, 0, len(self.s) - 2)
 
-    def _integral_from_first(self, s, cumulative):
-        i = self._segment(s)
-        h = s - self.s[i]
-        return cumulative[i] + self.f[i] * h + 0.5 * self.slopes[i] * h * h
+    def _from_zero(self, s: float) -> float:
+        """``integral_0^s F`` by trapezoids over the table's pieces between 0 and ``s`` (F is linear on each)."""
+        nodes = [0.0, *(p for p in self.s if min(0.0, s) < p < max(0.0, s)), s]
+        nodes = sorted(nodes) if s >= 0.0 else sorted(nodes, reverse=True)
+        return math.fsum(0.5 * (self.force(b) + self.force(a)) * (b - a) for a, b in zip(nodes, nodes[1:]))
+
+    def _anchors(self, s):
+        """For each ``s``: the table point nearest to ``s`` on the way from 0 to ``s`` (index), or -1 for 0
+        itself when no table point lies between them."""
+        right = np.searchsorted(self.s, s, side="right") - 1          # last point <= s
+        left = np.searchsorted(self.s, s, side="left")                # first point >= s
+        n = len(self.s)
+        positive = (s >= 0.0) & (right >= 0)
+        positive &= self.s[np.clip(right, 0, n - 1)] >= 0.0
+        negative = (s < 0.0) & (left < n)
+        negative &= self.s[np.clip(left, 0, n - 1)] <= 0.0
+        return np.where(positive, right, np.where(negative, left, -1))
 
     def force(self, s):
         """F(s) in N on floats or arrays (numpy), extrapolated linearly beyond the table."""
@@ -158,7 +171,10 @@ class Characteristic:
     def integral(self, s):
         """``integral_0^s F`` (N m for a spring: J) on floats or arrays, exact (module docstring)."""
         s = np.asarray(s, dtype=float)
-        out = self._integral_from_first(s, self.integral_at_points)
+        k = self._anchors(s)
+        anchor = np.where(k >= 0, self.s[np.clip(k, 0, None)], 0.0)
+        at_anchor = np.where(k >= 0, self.integral_at_points[np.clip(k, 0, None)], 0.0)
+        out = at_anchor + 0.5 * (self.force(anchor) + self.force(s)) * (s - anchor)  # F linear between them
         return float(out) if out.ndim == 0 else out
 
     def largest_magnitude(self, low: float, high: float) -> float:

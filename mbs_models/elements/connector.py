@@ -16,16 +16,19 @@ force.  From these two definitions everything generic follows and is written onc
 
 * the force on the ground, positive in the recoil direction: ``+F`` if ``a`` is the ground, ``-F`` if
   ``b`` is (:attr:`Connector.support_sign`); the support force is their sum;
-* stored energy ``U(d)`` and dissipated power; their integrals close the energy balance per connector;
-* the linear stiffness of springs (the quadratic form behind the energy bounds of the early stop) and
-  the force bounds of each connector given bounds on ``d`` and ``d'``.
+* stored energy ``U(d) = integral_0^d F(s, 0) ds`` and dissipated power ``(F(d, d') - F(d, 0)) d'``; their
+  integrals close the energy balance per connector;
+* each connector's share of the energy bounds of the early stop (a quadratic potential's stiffness, or
+  its potential as a function) and its force bound given bounds on ``d`` and ``d'``.
 
-Element modules subclass :class:`Connector` where they need a law of their own (the asymmetric recoil
-damper, the contact laws) and keep Exudyn's built-in linear spring-damper otherwise.
+Element modules subclass :class:`Connector` with a law of their own (the asymmetric recoil damper, the
+contact laws) -- the law is the one mandatory part, the rest is derived from it (see :class:`Connector`) --
+and use :class:`LinearSpringDamper`, Exudyn's built-in linear spring-damper, otherwise.
 """
 
 from __future__ import annotations
 
+import abc
 import math
 from dataclasses import dataclass
 from typing import Callable
@@ -55,39 +58,73 @@ class Body:
 Quadrature = Callable[[np.ndarray], np.ndarray]
 
 
-class Connector:
-    """A force between points ``a`` and ``b`` of the recoil axis (see the module docstring).
+class Connector(abc.ABC):
+    """A force between points ``a`` and ``b`` of the recoil axis (see the module docstring): the element contract.
 
-    The base class is Exudyn's linear spring-damper ``F = stiffness d + damping d'`` (either may be 0),
-    which needs no user function.  Subclasses with a law of their own set :attr:`needs_user_function`
-    and implement :meth:`law`.
+    The force law is the connector: everything else the engine, the post-processing and the early stop
+    need is derived from it, unless the element gives it in closed form (which the conformance suite,
+    ``tests/elements/test_conformance.py``, then checks against the derived one).
+
+    To add a connector (a law of your own)
+    ---------------------------------------
+    1. Subclass :class:`Connector` and implement :meth:`law` ``(d, rate, ops) -> F`` in N, written over the
+       backend ops (:mod:`.ops`: plain floats, numpy arrays, Exudyn symbolic expressions) so that one law runs
+       in all three.  It is the one mandatory part: a subclass without it cannot be instantiated (TypeError
+       when the scene is assembled), never a silent zero force.
+    2. Call ``super().__init__(name, element, a, b)``.
+    3. Declare what holds for your law (class attributes; the defaults are the safe ones):
+       :attr:`monotone` (F non-decreasing in d and in rate: the force bound is then exact from two
+       evaluations), :attr:`stores_energy` (False only if ``F(d, 0) = 0`` for every d: a pure damper),
+       :attr:`coordinate_range` (where the law is defined).
+    4. Optionally give closed forms, each of which replaces a derived default and is checked against it:
+       :meth:`python_stored_energy` / :meth:`stored_energy` (default: the quadrature of ``F(s, 0)``),
+       :meth:`tangent_stiffness` (default: a central difference), :meth:`force_bound` (default: the law at the
+       corners of the box for a monotone law, else a dense sampling with a margin), and a quadratic potential
+       (:attr:`quadratic_potential` with :attr:`quadratic_stiffness`: the energy bounds of the early stop then
+       use it in their quadratic form; otherwise the potential enters them as a function).
+    5. Write its reference term in ``validation/reference/terms`` (or register one from your module,
+       :func:`validation.reference.terms.register_term`) and register the element's table
+       (:func:`mbs_models.register_element` from outside the package).
+
+    Derived pieces (the equations; DESIGN.md "The element contract")::
+
+        conservative part   F_c(d)     = F(d, 0)
+        stored energy       U(d)       = integral_0^d F_c(s) ds
+        dissipated power    P(d, d')   = (F(d, d') - F_c(d)) d'
+        tangent stiffness   k_t(d)     = dF_c/dd,  tangent damping  c_t = dF/dd' at (0, 0)
+        force bound         B(D, V)   >= max |F(d, d')| over |d| <= D, |d'| <= V
 
     Attributes
     ----------
     name: unique id in the scene: the key of its energies and outputs (``"recoil_spring"``, ``"contact"``).
     element: the name of the scene element it belongs to (the per-element energy table groups by it).
     a, b: body names (or :data:`GROUND`) at the connector's two markers.
-    stiffness: linear stiffness in N/m (0: none).
-    damping: linear damping in N s/m (0: none).
     records_force: a sensor records the force at every step (contacts: their force is an output).
     """
 
-    needs_user_function = False
+    #: The law runs as Exudyn's spring-force user function (False only for a law Exudyn has built in).
+    needs_user_function = True
     records_force = False
     is_contact = False
     #: True for a law that can hold its bodies at rest anywhere in a band of positions (Coulomb friction): the
     #: scene then has no single rest state, and a solve is not stopped at rest (:mod:`mbs_models.engine.rest`).
     sticks = False
-    #: True when the stored energy is the quadratic form ``linear_stiffness d^2 / 2`` (or none): the energy
-    #: bounds of the early stop then use it as such.  False for a nonlinear potential, which may also be
-    #: negative (the recuperator's gas spring): the bounds treat it separately.
-    quadratic_potential = True
+    #: True when ``F(d, d')`` is non-decreasing in ``d`` and in ``d'``: the derived force bound is then exact
+    #: (the law at the box's corners ``(D, V)`` and ``(-D, -V)``).  False: a dense sampling with a margin.
+    monotone = False
+    #: True when the stored energy is the quadratic form ``quadratic_stiffness d^2 / 2`` (or none): the energy
+    #: bounds of the early stop then use it as such.  False (the default) for any other potential, which the
+    #: bounds take as a function (:class:`~mbs_models.engine.final_metrics.PotentialWell`).
+    quadratic_potential = False
+    #: False only for a law whose conservative part ``F(d, 0)`` vanishes everywhere (a pure damper, friction).
+    stores_energy = True
+    #: True if the connector may dissipate energy (the default: the derived dissipated power is then integrated).
+    dissipates = True
 
-    def __init__(self, name: str, element: str, a: str, b: str, *, stiffness: float = 0.0, damping: float = 0.0):
+    def __init__(self, name: str, element: str, a: str, b: str):
         if a == b:
             raise ValueError(f"connector {name!r} joins {a!r} to itself")
         self.name, self.element, self.a, self.b = name, element, a, b
-        self.stiffness, self.damping = float(stiffness), float(damping)
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}({self.name!r}, {self.a} -> {self.b})"
@@ -98,10 +135,10 @@ class Connector:
         """+1 if ``a`` is the ground, -1 if ``b`` is, 0 for a connector between two bodies."""
         return 1.0 if self.a == GROUND else (-1.0 if self.b == GROUND else 0.0)
 
-    # ------------------------------------------------------------------ the law
+    # ------------------------------------------------------------------ the law (mandatory)
+    @abc.abstractmethod
     def law(self, d, rate, ops: Ops):
         """The force in N at relative coordinate ``d`` (m) and rate ``rate`` (m/s), over ``ops``."""
-        return self.stiffness * d + self.damping * rate
 
     def user_function_law(self, ops: Ops) -> Callable:
         """``f(d, rate)`` to record as Exudyn's spring-force user function (see :meth:`law`)."""
@@ -115,19 +152,28 @@ class Connector:
         """The force (N) at one state (plain floats)."""
         return self.law(d, rate, PYTHON_OPS)
 
+    def conservative_force(self, d: float) -> float:
+        """``F_c(d) = F(d, 0)`` in N: the force at rest, whose integral is the stored energy."""
+        return self.python_force(d, 0.0)
+
     # ------------------------------------------------------------------ Exudyn
+    def builtin_coefficients(self) -> tuple[float, float]:
+        """``(stiffness N/m, damping N s/m)`` of Exudyn's built-in linear law (0, 0 where a user function acts)."""
+        return 0.0, 0.0
+
     def add_items(self, mbs, marker_a, marker_b, user_functions: str = "symbolic"):
         """Add the connector to an Exudyn system between two coordinate markers; return its ObjectIndex.
 
         An ``ObjectConnectorCoordinateSpringDamper`` with markers ``[marker_a, marker_b]``: Exudyn's
-        built-in linear law, or :meth:`user_function_law` as its spring-force user function
-        (``user_functions``: ``"symbolic"`` -- recorded once, evaluated in C++ -- or ``"python"``).  The
-        connector keeps the user function alive (:attr:`index` is the item).
+        built-in linear law (:meth:`builtin_coefficients`), or :meth:`user_function_law` as its spring-force
+        user function (``user_functions``: ``"symbolic"`` -- recorded once, evaluated in C++ -- or
+        ``"python"``).  The connector keeps the user function alive (:attr:`index` is the item).
         """
         from exudyn.itemInterface import ObjectConnectorCoordinateSpringDamper
 
+        stiffness, damping = self.builtin_coefficients()
         index = mbs.AddObject(ObjectConnectorCoordinateSpringDamper(
-            markerNumbers=[marker_a, marker_b], stiffness=self.stiffness, damping=self.damping,
+            markerNumbers=[marker_a, marker_b], stiffness=stiffness, damping=damping,
             visualization={"show": False, "drawSize": -1.0, "color": [-1.0, -1.0, -1.0, -1.0]}))
         self._set_user_function(mbs, index, user_functions)
         self.index = index
@@ -137,12 +183,13 @@ class Connector:
         """Write this connector's numbers into ``index``, the item :meth:`add_items` made for a connector of
         the same class and ends (an earlier point of a sweep; :mod:`mbs_models.engine.reuse`).
 
-        Afterwards the item is what :meth:`add_items` would have made: ``stiffness`` and ``damping`` set, the
+        Afterwards the item is what :meth:`add_items` would have made: the built-in coefficients set, the
         user function (if any) recorded anew from this connector's law.  A subclass that adds other items
         overrides both methods.
         """
-        mbs.SetObjectParameter(index, "stiffness", self.stiffness)
-        mbs.SetObjectParameter(index, "damping", self.damping)
+        stiffness, damping = self.builtin_coefficients()
+        mbs.SetObjectParameter(index, "stiffness", stiffness)
+        mbs.SetObjectParameter(index, "damping", damping)
         self._set_user_function(mbs, index, user_functions)
         self.index = index
 
@@ -158,60 +205,117 @@ class Connector:
         self._user_function = make_user_function(mbs, user_function, user_functions, index)
         mbs.SetObjectParameter(index, "springForceUserFunction", self._user_function)
 
-    # ------------------------------------------------------------------ energy
-    @property
-    def stores_energy(self) -> bool:
-        """True if the connector has a potential (a spring, a contact)."""
-        return self.stiffness > 0
-
-    @property
-    def dissipates(self) -> bool:
-        """True if the connector dissipates energy (a damper, a damped contact)."""
-        return self.damping > 0
+    # ------------------------------------------------------------------ energy (derived unless closed form)
+    def python_stored_energy(self, d: float) -> float:
+        """Stored energy ``U(d)`` in J at one ``d`` (m): :meth:`derived_stored_energy` unless closed form."""
+        return self.derived_stored_energy(d)
 
     def stored_energy(self, d):
-        """Stored (potential) energy in J at ``d`` (m): ``stiffness d^2 / 2``."""
-        return 0.5 * self.stiffness * np.asarray(d, dtype=float) ** 2
+        """Stored energy in J at the ``d`` (m, an array or a float): :meth:`derived_stored_energy_array` unless
+        closed form."""
+        return self.derived_stored_energy_array(d)
 
-    def python_stored_energy(self, d: float) -> float:
-        """:meth:`stored_energy` at one ``d`` (m), a plain float (J)."""
-        return float(self.stored_energy(d))
+    def derived_stored_energy(self, d: float) -> float:
+        """``U(d) = integral_0^d F(s, 0) ds`` (J) by adaptive Gauss-Kronrod quadrature (scipy's ``quad``, to a
+        relative 1e-12) on the pieces between the :attr:`kinks`; 0 for a connector that stores none, inf outside
+        :attr:`coordinate_range`."""
+        d = float(d)
+        if not self.stores_energy or d == 0.0:
+            return 0.0
+        low, high = self.coordinate_range
+        if not low < d < high:
+            return math.inf
+        from scipy.integrate import quad
+
+        kinks = sorted(k for k in self.kinks if min(0.0, d) < k < max(0.0, d))
+        value = 0.0
+        for start, end in zip([0.0] + kinks if d > 0 else [0.0] + kinks[::-1], (kinks if d > 0 else kinks[::-1]) + [d]):
+            piece, _ = quad(self.conservative_force, start, end, epsabs=0.0, epsrel=1e-12, limit=200)
+            value += piece
+        return float(value)
+
+    def derived_stored_energy_array(self, d):
+        """:meth:`derived_stored_energy` over an array of ``d`` (m) at once: the distinct values and 0 sorted,
+        ``F(s, 0)`` integrated between neighbours (the :attr:`kinks` among them) by 8-point Gauss-Legendre (exact
+        for a polynomial force up to degree 15) and summed outward from ``d = 0``."""
+        array = np.asarray(d, dtype=float)
+        if not self.stores_energy:
+            return np.zeros_like(array)
+        values = array.ravel()
+        kinks = [k for k in self.kinks if values.size and float(np.min(values)) < k < float(np.max(values))]
+        points, inverse = np.unique(np.concatenate((values, [0.0], kinks)), return_inverse=True)
+        zero = int(np.searchsorted(points, 0.0))
+        nodes, weights = np.polynomial.legendre.leggauss(8)
+        left, right = points[:-1], points[1:]
+        half = 0.5 * (right - left)
+        s = (0.5 * (left + right))[:, None] + half[:, None] * nodes[None, :]
+        forces = np.asarray(self.law(s, np.zeros_like(s), NUMPY_OPS), dtype=float) * np.ones_like(s)
+        pieces = half * (forces @ weights)
+        energy = np.zeros(points.size)  # summed outward from 0 on each side (no cancellation near d = 0)
+        energy[zero + 1:] = np.cumsum(pieces[zero:])
+        energy[:zero] = -np.cumsum(pieces[:zero][::-1])[::-1]
+        return energy[inverse[:values.size]].reshape(array.shape)
 
     @property
     def coordinate_range(self) -> tuple[float, float]:
         """(lowest, highest) d in m where the law is defined (all of it, but for a gas spring's singularity)."""
         return -math.inf, math.inf
 
+    @property
+    def kinks(self) -> tuple[float, ...]:
+        """The d (m) where ``F(d, 0)`` or its slope jumps (a contact's offset): the derived stored energy
+        integrates piece by piece between them.  None for a smooth law (the default)."""
+        return ()
+
     def dissipated_energy(self, quadrature: Quadrature, d_nodes, rate_nodes, times_nodes, stored):
-        """Cumulative dissipated energy (J) at the output samples: ``damping d'^2`` integrated.
+        """Cumulative dissipated energy (J) at the output samples: ``(F(d, d') - F(d, 0)) d'`` integrated.
 
         ``d_nodes``, ``rate_nodes`` and ``times_nodes`` are values at each output interval's quadrature
         nodes (shape (nodes, intervals)); ``stored`` is :meth:`stored_energy` at the output samples.
         """
-        return quadrature(self.damping * rate_nodes ** 2)
+        power = (self.force(d_nodes, rate_nodes, times_nodes)
+                 - self.force(d_nodes, np.zeros_like(rate_nodes), times_nodes)) * rate_nodes
+        return quadrature(power)
 
-    # ------------------------------------------------------------------ bounds
+    # ------------------------------------------------------------------ stiffness
+    @property
+    def quadratic_stiffness(self) -> float:
+        """k (N/m) of a quadratic potential ``U = k d^2 / 2`` (:attr:`quadratic_potential`); 0 otherwise."""
+        return 0.0
+
+    def tangent_stiffness(self, d: float) -> float:
+        """``dF(d, 0)/dd`` in N/m: :meth:`derived_tangent_stiffness` unless closed form."""
+        return self.derived_tangent_stiffness(d)
+
+    def derived_tangent_stiffness(self, d: float) -> float:
+        """``(F(d + h, 0) - F(d - h, 0)) / (2 h)`` (N/m), ``h = 6e-6 max(|d|, 1 mm)`` (about the cube root of
+        the double precision: truncation and round-off errors balance)."""
+        h = 6e-6 * max(abs(d), 1e-3)
+        return (self.python_force(d + h, 0.0) - self.python_force(d - h, 0.0)) / (2.0 * h)
+
     @property
     def linear_damping(self) -> float:
-        """Damping (N s/m) of the linearised connector (stability checks)."""
-        return self.damping
+        """Damping (N s/m) of the linearised connector (stability checks): ``dF/dd'`` at rest, by a central
+        difference of step 1 mm/s."""
+        h = 1e-3
+        slope = (self.python_force(0.0, h) - self.python_force(0.0, -h)) / (2.0 * h)
+        return slope if math.isfinite(slope) and slope > 0.0 else 0.0
 
     @property
     def linear_stiffness(self) -> float:
-        """Stiffness (N/m) of the connector's linear, always-acting spring: its energy ``k d^2 / 2``
-        enters the quadratic form of the energy bounds."""
-        return self.stiffness
+        """Stiffness (N/m) of the linearised connector (stability checks, time scales): the tangent stiffness
+        at d = 0 (0 where it is not finite and positive).  It is *not* the energy bounds' quadratic form
+        (:attr:`quadratic_stiffness`)."""
+        k = self.tangent_stiffness(0.0)
+        return k if math.isfinite(k) and k > 0.0 else 0.0
 
     def always_acting_fields(self) -> tuple[str | None, str | None]:
         """The fields of the connector's scene table that set :attr:`linear_stiffness` and :attr:`linear_damping`
         where the connector acts with them in every state (a linear spring, a linear damper), None where not.
 
-        The up-front time-scale check (:mod:`mbs_models.engine.time_scales`) counts and names them.  Exudyn's
-        linear spring-damper as it is: ``stiffness`` and ``damping`` (those it has); a subclass (a contact, a law
-        of its own, whose linearisation holds in some states only) none unless it says so."""
-        if type(self) is not Connector:
-            return None, None
-        return ("stiffness" if self.stiffness else None), ("damping" if self.damping else None)
+        The up-front time-scale check (:mod:`mbs_models.engine.time_scales`) counts and names them.  A law of
+        its own (a contact, whose linearisation holds in some states only) none unless it says so."""
+        return None, None
 
     @property
     def first_step_limit(self) -> float:
@@ -223,9 +327,115 @@ class Connector:
         its fastest motion here; the engine starts the solve with the smallest of these limits."""
         return math.inf
 
+    # ------------------------------------------------------------------ bounds
     def force_bound(self, d_bound: float, rate_bound: float, energy: float) -> float:
         """Bound (N) on |F| when |d| <= ``d_bound`` (m) and |d'| <= ``rate_bound`` (m/s) and the
-        mechanical energy is ``energy`` (J) at most."""
+        mechanical energy is ``energy`` (J) at most: :meth:`derived_force_bound` unless closed form."""
+        return self.derived_force_bound(d_bound, rate_bound)
+
+    #: Samples per axis of the box in :meth:`derived_force_bound` for a law not declared :attr:`monotone`.
+    BOUND_SAMPLES = 33
+
+    def derived_force_bound(self, d_bound: float, rate_bound: float) -> float:
+        """Bound (N) on |F(d, d')| over the box |d| <= D, |d'| <= V, from the law alone; inf where the box
+        leaves :attr:`coordinate_range` or the law is not finite on it.
+
+        * :attr:`monotone` law: ``max(|F(D, V)|, |F(-D, -V)|)``, exact (F is largest at one corner and smallest
+          at the opposite one).
+        * otherwise: the largest |F| on a grid of :attr:`BOUND_SAMPLES`^2 points (the corners and edges
+          included) plus the largest change of F between neighbouring grid points: a true bound for a law
+          monotone on each grid cell (piecewise monotone with its kinks on the grid), an estimate with a
+          one-cell Lipschitz margin otherwise.
+        """
+        D, V = abs(float(d_bound)), abs(float(rate_bound))
+        if not (math.isfinite(D) and math.isfinite(V)):
+            return math.inf
+        low, high = self.coordinate_range
+        if not (low < -D and D < high):
+            return math.inf
+        if self.monotone:
+            values = (self.python_force(D, V), self.python_force(-D, -V))
+            bound = max(abs(v) for v in values)
+            return bound if math.isfinite(bound) else math.inf
+        n = self.BOUND_SAMPLES
+        d = np.linspace(-D, D, n)
+        rate = np.linspace(-V, V, n)
+        dd, rr = np.meshgrid(d, rate, indexing="ij")
+        with np.errstate(all="ignore"):
+            F = np.asarray(self.force(dd, rr), dtype=float) * np.ones_like(dd)
+        if not np.all(np.isfinite(F)):
+            return math.inf
+        margin = max(float(np.max(np.abs(np.diff(F, axis=0)), initial=0.0)),
+                     float(np.max(np.abs(np.diff(F, axis=1)), initial=0.0)))
+        return float(np.max(np.abs(F))) + margin
+
+
+class LinearSpringDamper(Connector):
+    """Exudyn's built-in linear spring-damper ``F = stiffness d + damping d'`` (either may be 0): no user function.
+
+    Closed forms (checked against the derived ones by the conformance suite): ``U = stiffness d^2 / 2`` (a
+    quadratic potential), ``k_t = stiffness``, ``|F| <= stiffness D + damping V``.
+
+    Attributes: stiffness in N/m, damping in N s/m (both >= 0).
+    """
+
+    needs_user_function = False
+    quadratic_potential = True
+    monotone = True
+
+    def __init__(self, name: str, element: str, a: str, b: str, *, stiffness: float = 0.0, damping: float = 0.0):
+        super().__init__(name, element, a, b)
+        self.stiffness, self.damping = float(stiffness), float(damping)
+
+    def law(self, d, rate, ops: Ops):
+        return self.stiffness * d + self.damping * rate
+
+    def builtin_coefficients(self) -> tuple[float, float]:
+        return self.stiffness, self.damping
+
+    @property
+    def stores_energy(self) -> bool:
+        """True if the connector has a spring."""
+        return self.stiffness > 0
+
+    @property
+    def dissipates(self) -> bool:
+        """True if the connector has a damper."""
+        return self.damping > 0
+
+    def stored_energy(self, d):
+        """Stored (potential) energy in J at ``d`` (m): ``stiffness d^2 / 2``."""
+        return 0.5 * self.stiffness * np.asarray(d, dtype=float) ** 2
+
+    def python_stored_energy(self, d: float) -> float:
+        """:meth:`stored_energy` at one ``d`` (m), a plain float (J)."""
+        return float(self.stored_energy(d))
+
+    def dissipated_energy(self, quadrature: Quadrature, d_nodes, rate_nodes, times_nodes, stored):
+        """``damping d'^2`` integrated (J)."""
+        return quadrature(self.damping * rate_nodes ** 2)
+
+    @property
+    def quadratic_stiffness(self) -> float:
+        return self.stiffness
+
+    def tangent_stiffness(self, d: float) -> float:
+        return self.stiffness
+
+    @property
+    def linear_damping(self) -> float:
+        return self.damping
+
+    @property
+    def linear_stiffness(self) -> float:
+        return self.stiffness
+
+    def always_acting_fields(self) -> tuple[str | None, str | None]:
+        """``stiffness`` and ``damping`` (those it has): the linear law acts with them in every state."""
+        return ("stiffness" if self.stiffness else None), ("damping" if self.damping else None)
+
+    def force_bound(self, d_bound: float, rate_bound: float, energy: float) -> float:
+        """``stiffness D + damping V`` (N)."""
         bound = 0.0
         if self.stiffness > 0:
             bound += self.stiffness * d_bound

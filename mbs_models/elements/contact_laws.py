@@ -402,6 +402,11 @@ class ContactConnector(Connector):
         if spec.contact_law.restitution:
             self.capture = OnsetCapture(spec.restitution_factor, spec.impact_velocity_floor, self.offset)
 
+    @property
+    def kinks(self) -> tuple[float, ...]:
+        """The offset (m): the force at rest is 0 before it, ``k p^n`` after."""
+        return (self.offset,)
+
     # ------------------------------------------------------------------ the law
     def penetration(self, d):
         """p = d - offset (m), > 0 in contact."""

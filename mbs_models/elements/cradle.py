@@ -202,6 +202,9 @@ class CradleFriction(Connector):
     """
 
     sticks = True  # exact Coulomb holds the barrel anywhere its other forces stay within mu N
+    needs_user_function = False  # Exudyn's built-in regularised friction (add_items)
+    stores_energy = False        # F(d, 0) = 0
+    monotone = True              # mu N sat(v / v_reg): non-decreasing in v, independent of d
 
     def __init__(self, name: str, element: str, a: str, b: str, friction_force: float, friction_velocity: float):
         super().__init__(name, element, a, b)

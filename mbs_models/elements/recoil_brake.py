@@ -205,6 +205,8 @@ class RecoilBrakeConnector(Connector):
     """
 
     needs_user_function = True
+    #: ``F(d, 0) = 0``: the brake only dissipates
+    stores_energy = False
 
     def __init__(self, brake: RecoilBrake, scene=None):
         super().__init__(RecoilBrake.TABLE, RecoilBrake.TABLE, GROUND, BARREL)

@@ -57,17 +57,21 @@ class RecoilDamperConnector(Connector):
     """The damper as a connector ground -> barrel (d = x_M, d' = v_M): built-in when symmetric."""
 
     def __init__(self, damper: RecoilDamper):
-        super().__init__(RecoilDamper.TABLE, RecoilDamper.TABLE, GROUND, BARREL,
-                         damping=damper.recoil if damper.symmetric else 0.0)
+        super().__init__(RecoilDamper.TABLE, RecoilDamper.TABLE, GROUND, BARREL)
         self.damper = damper
         self.needs_user_function = not damper.symmetric
 
+    #: ``c(v) v`` with c >= 0 is non-decreasing in v and independent of d
+    monotone = True
+    #: ``F(d, 0) = 0``: a pure damper
+    stores_energy = False
+
+    def builtin_coefficients(self) -> tuple[float, float]:
+        """Exudyn's built-in linear damper ``(0, c)`` when symmetric; a user function otherwise."""
+        return 0.0, (self.damper.recoil if self.damper.symmetric else 0.0)
+
     def law(self, d, rate, ops: Ops):
         return recoil_damper_force(rate, self.damper, ops)
-
-    @property
-    def dissipates(self) -> bool:
-        return True
 
     def dissipated_energy(self, quadrature, d_nodes, rate_nodes, times_nodes, stored):
         """``c(v) v^2`` integrated (J)."""

@@ -2,7 +2,7 @@
 
 Table ``[recoil_spring]``: ``stiffness`` (N/m, >= 0; 27500 N/m in the paper).  Force on the barrel
 ``-k x_M``, on the ground (the support) ``+k x_M``; stored energy ``k x_M^2 / 2``.  It is Exudyn's
-built-in linear connector (no user function); a zero stiffness adds nothing.
+built-in linear connector (:class:`~.connector.LinearSpringDamper`, no user function); a zero stiffness adds nothing.
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 from .barrel import BARREL
-from .connector import GROUND, Connector
+from .connector import GROUND, Connector, LinearSpringDamper
 from .table import Rule, Table
 
 
@@ -31,4 +31,4 @@ class RecoilSpring(Table):
         """One linear spring ground -> barrel (none if the stiffness is 0)."""
         if self.stiffness <= 0:
             return []
-        return [Connector(self.TABLE, self.TABLE, GROUND, BARREL, stiffness=self.stiffness)]
+        return [LinearSpringDamper(self.TABLE, self.TABLE, GROUND, BARREL, stiffness=self.stiffness)]

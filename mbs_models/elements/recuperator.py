@@ -280,7 +280,10 @@ class RecuperatorConnector(Connector):
     """
 
     needs_user_function = True
-    quadratic_potential = False
+    #: F increases with d and does not depend on d'
+    monotone = True
+    #: F does not depend on d': nothing dissipated
+    dissipates = False
 
     def __init__(self, name: str, element: str, recuperator: Recuperator, *, stroke: float = 0.0):
         super().__init__(name, element, GROUND, BARREL)
@@ -299,11 +302,7 @@ class RecuperatorConnector(Connector):
         """d (m) where the law is defined: below ``V0 / A``."""
         return -math.inf, self.recuperator.exhausted_at
 
-    # ------------------------------------------------------------------ energy
-    @property
-    def stores_energy(self) -> bool:
-        return True
-
+    # ------------------------------------------------------------------ energy (closed forms)
     def stored_energy(self, d):
         """``U(d)`` in J (module docstring)."""
         return self.recuperator.stored_energy(d)
@@ -317,6 +316,10 @@ class RecuperatorConnector(Connector):
         if self.exponent == 1.0:
             return r.initial_pressure * self.gas_volume * log_r
         return r.initial_pressure * self.gas_volume / (self.exponent - 1.0) * math.expm1((self.exponent - 1.0) * log_r)
+
+    def tangent_stiffness(self, d: float) -> float:
+        """``n p0 A^2 / V0 (V0 / (V0 - A d))^(n+1)`` in N/m (:meth:`Recuperator.tangent_stiffness`)."""
+        return self.recuperator.tangent_stiffness(d)
 
     # ------------------------------------------------------------------ bounds
     @property

@@ -119,7 +119,7 @@ class TabulatedDamper(Table):
 class TabulatedDamperConnector(Connector):
     """The tabulated damper as a connector ground -> barrel (d' = v_M), a user function."""
 
-    needs_user_function = True
+    stores_energy = False   # F(d, 0) = F(0) = 0: the table passes through (0, 0)
 
     def __init__(self, name: str, element: str, damper: TabulatedDamper, key: str = TabulatedDamper.TABLE):
         super().__init__(name, element, GROUND, BARREL)
@@ -135,10 +135,6 @@ class TabulatedDamperConnector(Connector):
 
     def python_force(self, d: float, rate: float) -> float:
         return float(self.characteristic.force(rate))
-
-    @property
-    def dissipates(self) -> bool:
-        return True
 
     def dissipated_energy(self, quadrature, d_nodes, rate_nodes, times_nodes, stored):
         """``F(v) v`` integrated (J), >= 0.  A run whose velocity left the table gets a

@@ -121,8 +121,8 @@ class TabulatedSpring(Table):
 class TabulatedSpringConnector(Connector):
     """The tabulated spring as a connector ground -> barrel (d = x_M), a user function."""
 
-    needs_user_function = True
-    quadratic_potential = False
+    monotone = True      # F non-decreasing in d (checked on the table), independent of the rate
+    dissipates = False
 
     def __init__(self, name: str, element: str, spring: TabulatedSpring, key: str = TabulatedSpring.TABLE):
         super().__init__(name, element, GROUND, BARREL)
@@ -140,12 +140,9 @@ class TabulatedSpringConnector(Connector):
         return float(self.characteristic.force(d))
 
     @property
-    def stores_energy(self) -> bool:
-        return True
-
-    @property
-    def dissipates(self) -> bool:
-        return False
+    def kinks(self) -> tuple[float, ...]:
+        """The table's displacements (m): the force's slope jumps there."""
+        return tuple(float(x) for x in self.characteristic.s)
 
     def stored_energy(self, d):
         """``U(d) = integral_0^d F`` (J), exact.  Given a run's samples (an array), a run that left the table gets

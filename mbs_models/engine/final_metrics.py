@@ -44,9 +44,15 @@ so with the energy above the floor, ``E' = E - W*`` (>= 0), every bound above ho
 E, and the well adds its own: ``W(x_b) <= W* + E'`` confines ``x_b`` to the sublevel interval
 ``[lo(E'), hi(E')]`` of W (found by root finding; ``hi < V0/A`` for the gas spring, whose potential
 diverges there).  That interval bounds x_b (``x_M <= hi``), every member's coordinate (a stop's
-penetration, the gas spring's stroke, hence their forces).  The numerical slack applies to E'.  A
-connector with such a potential anywhere else (not between the ground and one body, or in a well with
-no minimum) leaves the scene without bounds: it runs to its end time.
+penetration, the gas spring's stroke, hence their forces).  The numerical slack applies to E'.
+
+Such a potential anywhere else (between two bodies, or from the ground to a second body) is a **loose
+well** of its own coordinate: ``U_c(d) >= U*_c``, its minimum where ``F_c(d*, 0) = 0`` (a progressive spring
+between the barrel and an absorber: ``U* = 0`` at d = 0).  The floor is then ``W* + sum_c U*_c``, E' the
+energy above it, and ``U_c(d) <= U*_c + E'`` bounds the connector's d (its force bound, if it touches the
+ground).  A potential without a minimum (or a well with none) leaves the scene without bounds: it runs to
+its end time.  Both wells assume what the contract's conformance suite checks on samples: ``F(d, 0)``
+non-decreasing (a convex U), so that Newton's method from outside a sublevel interval stays outside.
 
 Finality (what :class:`FinalityTracker` decides from the states it is shown)
 ---------------------------------------------------------------------------
@@ -156,7 +162,7 @@ class _QuadraticForm:
         n = len(mechanism.bodies)
         K = np.zeros((n, n))
         for connector in mechanism.connectors:
-            k = connector.linear_stiffness if connector.quadratic_potential else 0.0
+            k = connector.quadratic_stiffness if connector.quadratic_potential else 0.0
             if k > 0:
                 g = mechanism.direction(connector)
                 K += k * np.outer(g, g)
@@ -179,6 +185,11 @@ class _QuadraticForm:
         """Orthonormal columns spanning K's null space (the position changes no spring resists), shape
         (bodies, dimension)."""
         return self._vectors[:, ~self._keep]
+
+
+def general_potentials(mechanism: Mechanism) -> list:
+    """The connectors whose potential is given as a function (not a quadratic form, not a contact's)."""
+    return [c for c in mechanism.connectors if c.stores_energy and not c.is_contact and not c.quadratic_potential]
 
 
 class PotentialWell:
@@ -218,9 +229,34 @@ class PotentialWell:
 
     @classmethod
     def of(cls, mechanism: Mechanism) -> "PotentialWell | None":
-        general = [c for c in mechanism.connectors
-                   if c.stores_energy and not c.is_contact and not c.quadratic_potential]
-        return cls(mechanism, general) if general else None
+        """The well of the general potentials between the ground and one body (the body of the first such
+        connector; those of other bodies are :meth:`loose`); None without any."""
+        grounded = [c for c in general_potentials(mechanism) if GROUND in (c.a, c.b)]
+        if not grounded:
+            return None
+        first = grounded[0].b if grounded[0].a == GROUND else grounded[0].a
+        return cls(mechanism, [c for c in grounded if first in (c.a, c.b)])
+
+    @classmethod
+    def loose(cls, mechanism: Mechanism, well: "PotentialWell | None") -> list["PotentialWell"]:
+        """One well per general potential outside ``well`` (between two bodies, or from the ground to another
+        body): ``W(d) = U_c(d)`` in the connector's own coordinate (:meth:`of_connector`)."""
+        return [cls.of_connector(c) for c in general_potentials(mechanism) if well is None or c not in well]
+
+    @classmethod
+    def of_connector(cls, connector) -> "PotentialWell":
+        """The well ``W(d) = U(d)`` of one connector in its own coordinate d (sign +1, no body): its minimum
+        ``U*`` at ``F(d*, 0) = 0`` (-inf where U has none), its sublevel interval bounding d."""
+        well = cls.__new__(cls)
+        well.body, well.members, well.signs = None, [connector], [1.0]
+        well.minimum = -math.inf
+        well.domain = connector.coordinate_range
+        well._ends = {}
+        found = well._minimise()
+        if found is not None:
+            well.argmin, well.minimum = found
+            well._ends = {-1.0: (0.0, well.argmin), 1.0: (0.0, well.argmin)}
+        return well
 
     def __contains__(self, connector) -> bool:
         return any(connector is c for c in self.members)
@@ -375,12 +411,15 @@ class EnergyBounds:
         #: other potentials); ``a``, ``b``: :func:`connector_ends`.
         self._energy_terms = tuple(
             (tuple((i, self._half_masses[i]) for i in kinetic),
-             tuple(connector_ends(mechanism, c) + (0.5 * c.stiffness,) for c in springs),
+             tuple(connector_ends(mechanism, c) + (0.5 * c.quadratic_stiffness,) for c in springs),
              tuple(connector_ends(mechanism, c) + (c.python_elastic,) for c in contacts)
              + tuple(connector_ends(mechanism, c) + (c.python_stored_energy,) for c in general))
             for kinetic, springs, contacts, general in self._groups if kinetic or springs or contacts or general)
         #: the potential well of a connector whose potential is not a quadratic form (None: there is none)
         self.well = PotentialWell.of(mechanism)
+        #: one well per general potential outside :attr:`well` (module docstring: their minima join the floor)
+        self.loose = PotentialWell.loose(mechanism, self.well)
+        self._floor = (0.0 if self.well is None else self.well.minimum) + sum(w.minimum for w in self.loose)
         self._barrel_coefficient = form.coefficient(np.eye(len(self.masses))[0]) if self.masses else math.inf
         self.contacts = mechanism.contacts
         self._contact_coefficients = [form.coefficient(mechanism.direction(c)) for c in self.contacts]
@@ -393,6 +432,7 @@ class EnergyBounds:
         ground = [c for c in mechanism.connectors if GROUND in (c.a, c.b)]
         self._ground = [(c, form.coefficient(mechanism.direction(c)), self._rate_coefficient(c)) for c in ground]
         self._free_oscillators = self._find_free_oscillators(mechanism)
+        self._loose_of = {id(w.members[0]): w for w in self.loose}
 
     def _rate_coefficient(self, connector) -> float:
         """``2 (1/m_b + 1/m_a)`` (the ground's term left out): ``|d'| <= sqrt(coefficient E)``."""
@@ -405,14 +445,16 @@ class EnergyBounds:
 
     @staticmethod
     def _find_free_oscillators(mechanism: Mechanism) -> dict[int, tuple[list, list]]:
-        """Bodies tied to the ground by linear connectors only (besides contacts): index -> (their
-        connectors, their contacts)."""
+        """Bodies tied to the ground only, by connectors whose potential is a quadratic form or none (besides
+        contacts): index -> (their connectors, their contacts).  (A potential given as a function may be
+        negative: the body's own energy would then bound nothing.)"""
         out = {}
         for i, body in enumerate(mechanism.bodies):
             touching = [c for c in mechanism.connectors if body.name in (c.a, c.b)]
             contacts = [c for c in touching if c.is_contact]
             others = [c for c in touching if not c.is_contact]
-            if i > 0 and all(GROUND in (c.a, c.b) for c in others):
+            if i > 0 and all(GROUND in (c.a, c.b) and (c.quadratic_potential or not c.stores_energy)
+                             for c in others):
                 out[i] = (others, contacts)
         return out
 
@@ -443,26 +485,27 @@ class EnergyBounds:
     # ---------------------------------------------------------------------------- the energy above the floor
     @property
     def energy_floor(self) -> float:
-        """A lower bound (J) of the stored energy over all states: 0, or the potential well's minimum W*."""
-        return 0.0 if self.well is None else self.well.minimum
+        """A lower bound (J) of the stored energy over all states: 0, or the minima of the potential wells
+        (the well's W* plus every loose potential's U*; -inf where one has none)."""
+        return self._floor
 
     def with_slack(self, energy: float) -> float:
-        """The energy (J) the bounds are evaluated at: ``E (1 + ENERGY_SLACK)``, or ``W* + (E - W*) (1 +
-        ENERGY_SLACK)`` with a potential well (the integration error scales with the energy above the floor)."""
-        if self.well is None:
+        """The energy (J) the bounds are evaluated at: ``E (1 + ENERGY_SLACK)``, or ``floor + (E - floor) (1 +
+        ENERGY_SLACK)`` with potential wells (the integration error scales with the energy above the floor)."""
+        if self.well is None and not self.loose:
             return energy * (1.0 + ENERGY_SLACK)
-        if not math.isfinite(self.well.minimum):
+        if not math.isfinite(self._floor):
             return energy
-        return self.well.minimum + (energy - self.well.minimum) * (1.0 + ENERGY_SLACK)
+        return self._floor + (energy - self._floor) * (1.0 + ENERGY_SLACK)
 
     def _excess(self, energy: float) -> float:
-        """``E' = E - W*`` (J, >= 0): the bound on every non-negative term of E (``max(E, 0)`` without a well;
-        inf where a nonlinear potential has no well)."""
-        if self.well is None:
+        """``E' = E - floor`` (J, >= 0): the bound on every non-negative term of E (``max(E, 0)`` without a
+        well; inf where a potential given as a function has no minimum)."""
+        if self.well is None and not self.loose:
             return max(energy, 0.0)
-        if not math.isfinite(self.well.minimum):
+        if not math.isfinite(self._floor):
             return math.inf
-        return max(energy - self.well.minimum, 0.0)
+        return max(energy - self._floor, 0.0)
 
     def contact_force(self, contact, x, v) -> float:
         """The force (N) of a contact at the state, with its current onset rate."""
@@ -485,7 +528,7 @@ class EnergyBounds:
         for c in connectors:
             if c.stores_energy:
                 d = m.relative_at(c, x)
-                energy += 0.5 * c.stiffness * d * d
+                energy += 0.5 * c.quadratic_stiffness * d * d
         return energy
 
     # ---------------------------------------------------------------------------- bounds
@@ -564,6 +607,9 @@ class EnergyBounds:
                 total += self.contact_force_bound(contact_index[id(c)], energy)
             elif self._in_well(c):  # |d| <= max(|lo|, |hi|) of the well's interval
                 total += c.force_bound(self.well.magnitude(c, e), math.sqrt(rate_coefficient * e), e)
+            elif id(c) in self._loose_of:  # |d| <= its own sublevel interval (and the springs' bound)
+                d_bound = min(self._loose_of[id(c)].magnitude(c, e), math.sqrt(coefficient * e))
+                total += c.force_bound(d_bound, math.sqrt(rate_coefficient * e), e)
             else:
                 total += c.force_bound(math.sqrt(coefficient * e), math.sqrt(rate_coefficient * e), e)
         return total

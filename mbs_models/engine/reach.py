@@ -97,9 +97,9 @@ def _free_recoil_reach(mechanism: Mechanism, bounds: EnergyBounds) -> list[float
     for c in springs:
         if c.stores_energy:
             g = mechanism.direction(c)
-            K += c.linear_stiffness * np.outer(g, g)
+            K += c.quadratic_stiffness * np.outer(g, g)
             body = c.b if c.b != GROUND else c.a
-            energy[root(index[body])] += 0.5 * c.linear_stiffness * mechanism.relative_at(c, x0) ** 2
+            energy[root(index[body])] += 0.5 * c.quadratic_stiffness * mechanism.relative_at(c, x0) ** 2
     roots = sorted({root(i) for i in range(n)})
     members = {r: [i for i in range(n) if root(i) == r] for r in roots}
     out = []

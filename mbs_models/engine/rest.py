@@ -99,8 +99,9 @@ class RestState:
         self.well = well
         self._x_r, self._gamma = float(rest_well_position), float(gamma)
         self._kinetic = tuple((i, 0.5 * body.mass) for i, body in enumerate(mechanism.bodies))
-        self._springs = tuple(connector_ends(mechanism, c) + (0.5 * c.linear_stiffness,) for c in mechanism.connectors
-                              if c.quadratic_potential and not c.is_contact and c.linear_stiffness > 0)
+        self._springs = tuple(connector_ends(mechanism, c) + (0.5 * c.quadratic_stiffness,)
+                              for c in mechanism.connectors
+                              if c.quadratic_potential and not c.is_contact and c.quadratic_stiffness > 0)
         self._elastic = tuple(connector_ends(mechanism, c) + (c.python_elastic,) for c in mechanism.contacts
                               if well is None or c not in well)
 
@@ -110,7 +111,10 @@ class RestState:
         (module docstring).  ``bounds``: the scene's :class:`EnergyBounds` if at hand (its potential well)."""
         if not dissipative(mechanism) or any(c.sticks for c in mechanism.connectors):
             return None
-        well = (bounds or EnergyBounds(mechanism)).well
+        bounds = bounds or EnergyBounds(mechanism)
+        if bounds.loose:  # a potential given as a function outside the well: its rest state is not modelled here
+            return None
+        well = bounds.well
         n = len(mechanism.bodies)
         form = _QuadraticForm(mechanism)
         null = form.null_space()

@@ -18,7 +18,7 @@ from __future__ import annotations
 from dataclasses import dataclass, fields, is_dataclass, replace
 from typing import Any, Iterator
 
-from ..elements import ELEMENT_TABLES, Table
+from ..elements import ELEMENT_TABLES, Table, on_register
 from ..elements.absorber import Absorber
 from ..elements.contact_laws import Contact
 from ..elements.table import rekey, suggestion
@@ -71,8 +71,20 @@ def _many_attribute(table: str) -> str:
     return table + "s"
 
 
-_SINGLE = {name: cls for name, cls in ELEMENT_TABLES.items() if not cls.MANY}
-_MANY = {_many_attribute(name): cls for name, cls in ELEMENT_TABLES.items() if cls.MANY}
+_SINGLE: dict[str, type] = {}
+_MANY: dict[str, type] = {}
+
+
+def _refresh_views() -> None:
+    """The single and array tables of :data:`ELEMENT_TABLES` (again after :func:`~mbs_models.register_element`)."""
+    _SINGLE.clear()
+    _SINGLE.update((name, cls) for name, cls in ELEMENT_TABLES.items() if not cls.MANY)
+    _MANY.clear()
+    _MANY.update((_many_attribute(name), cls) for name, cls in ELEMENT_TABLES.items() if cls.MANY)
+
+
+_refresh_views()
+on_register(_refresh_views)
 
 
 class Scene:

@@ -30,15 +30,25 @@ import tomllib
 from dataclasses import fields, replace
 from typing import Any, Mapping
 
-from ..elements import ELEMENT_TABLES, Table
+from ..elements import ELEMENT_TABLES, Table, on_register
 from ..elements.contact_laws import CONTACT_LAWS, LAW_FIELDS
 from ..elements.table import rekey, suggestion
 from ..errors import SceneError
 from ..inputs import check_toml_nesting
 from .container import Conventions, Scene
 
-_SINGLE_TABLES = [name for name, cls in ELEMENT_TABLES.items() if not cls.MANY]
-_TOP_LEVEL = sorted(["name", "conventions", "contact", "absorber", *_SINGLE_TABLES])
+_SINGLE_TABLES: list[str] = []
+_TOP_LEVEL: list[str] = []
+
+
+def _refresh_views() -> None:
+    """The keys a dotted override may start with (again after :func:`~mbs_models.register_element`)."""
+    _SINGLE_TABLES[:] = [name for name, cls in ELEMENT_TABLES.items() if not cls.MANY]
+    _TOP_LEVEL[:] = sorted(["name", "conventions", "contact", "absorber", *_SINGLE_TABLES])
+
+
+_refresh_views()
+on_register(_refresh_views)
 
 
 # ================================================================================================ keys

@@ -12,8 +12,10 @@ import math
 import numpy as np
 import pytest
 
-from mbs_models import Conventions, SceneError, model_i, model_ii, simplified_model, simulate
+from mbs_models import Conventions, SceneError, load_scene, model_i, model_ii, simplified_model, simulate
+from mbs_models.elements import Connector, LinearSpringDamper
 from mbs_models.engine import final_metrics as fm
+from mbs_models.scenes import scene_path
 from mbs_models.studies.sweep import run_scenes
 
 ALL = fm.FINAL_METRICS
@@ -294,3 +296,37 @@ def test_energy_is_summed_element_by_element_in_the_documented_order(name):
                 if c.stores_energy and not c.is_contact and not c.quadratic_potential:
                     expected += c.python_stored_energy(m.relative_at(c, x))
         assert b.energy(x, v) == expected
+
+
+class _ProgressiveActuator(Connector):
+    """The absorber's actuator made progressive, given by its law alone: ``F = k d + k3 d^3 + c d'`` (N)."""
+
+    def __init__(self, linear, cubic_stiffness: float):
+        super().__init__(linear.name, linear.element, linear.a, linear.b)
+        self.k, self.c, self.k3 = linear.stiffness, linear.damping, cubic_stiffness
+
+    def law(self, d, rate, ops):
+        return self.k * d + self.k3 * d * d * d + self.c * rate
+
+
+@pytest.mark.parametrize("name", ["model_i", "model_ii"])
+def test_a_potential_given_as_a_function_anywhere_keeps_the_early_stop(monkeypatch, name):
+    """A nonlinear potential between two bodies (model (i): barrel -> absorber, a loose well) or from the ground
+    to an absorber (model (ii): the absorber's well) neither loses nor breaks the early stop: it stops with the
+    full run's metrics."""
+    import conformance
+    from mbs_models.elements.absorber import Absorber
+
+    original = Absorber.connectors
+
+    def progressive(self, scene, element):
+        return [_ProgressiveActuator(c, 1e8) if isinstance(c, LinearSpringDamper) else c
+                for c in original(self, scene, element)]
+
+    monkeypatch.setattr(Absorber, "connectors", progressive)
+    scene = load_scene(scene_path(name))
+    bounds = fm.EnergyBounds(scene)
+    actuator = next(c for c in bounds.mechanism.connectors if isinstance(c, _ProgressiveActuator))
+    assert (bounds.well is not None and actuator in bounds.well) or any(actuator in w for w in bounds.loose)
+    assert bounds.energy_floor == 0.0  # U = k d^2/2 + k3 d^4/4 >= 0, its minimum 0 at d = 0
+    assert conformance.check_early_stop(scene, 10.0)

@@ -7,7 +7,8 @@ the bodies, connectors and roles of one such table to a
 the force on the bodies as a function of the state, the stored energy and dissipated power, the
 switching surfaces and how the mode is classified at a restart, and the contribution to the energy
 bounds of the early stop (:mod:`validation.reference.model`).  Adding an effect to the reference is
-adding one module here.
+adding one module here; a user's element defined outside the package registers its term with
+:func:`register_term`.
 
 Modules without ``TABLES`` are building blocks of the terms (:mod:`.contact_laws`, :mod:`.spring_damper`).
 The terms are found by the table names they declare (:data:`TERMS`, below), never listed here: the README
@@ -39,4 +40,41 @@ def _discover() -> dict[str, ModuleType]:
 #: table name -> term module
 TERMS: dict[str, ModuleType] = _discover()
 
-__all__ = ["TERMS"]
+
+def _redefined(old, new) -> bool:
+    """Is ``new`` the term ``old`` once more: the same name from the same file (its module imported again)?"""
+    import inspect
+
+    def origin(term):
+        try:
+            return getattr(term, "__qualname__", getattr(term, "__name__", None)), inspect.getfile(term)
+        except TypeError:
+            return None, id(term)
+
+    return origin(old) == origin(new)
+
+
+def register_term(term) -> object:
+    """Register the reference term of an element defined outside the package; returns ``term``.
+
+    ``term`` is a module (or any object) with ``TABLES`` (the scene table names it models) and
+    ``build(builder, key, table)`` (adds its bodies and connectors, subclasses of
+    :class:`validation.reference.model.Connector`, to the builder), exactly like the term modules of this
+    package.  Registering the same term again does nothing, and the same definition imported again (its module
+    reloaded) replaces the first; a table that already has another term, or a term without ``TABLES`` or
+    ``build``, is a TypeError.  The engine's side is
+    :func:`mbs_models.register_element`.
+    """
+    tables = getattr(term, "TABLES", None)
+    if isinstance(tables, str) or not tables or not callable(getattr(term, "build", None)):
+        raise TypeError(f"a reference term needs TABLES (a tuple of table names) and build(builder, key, table): "
+                        f"{term!r}")
+    for table in tables:
+        if TERMS.get(table, term) is not term and not _redefined(TERMS[table], term):
+            raise TypeError(f"[{table}] already has a reference term: {TERMS[table].__name__}")
+    for table in tables:
+        TERMS[table] = term
+    return term
+
+
+__all__ = ["TERMS", "register_term"]
