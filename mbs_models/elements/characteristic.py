@@ -28,14 +28,16 @@ import csv
 import io
 import math
 import warnings
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any, ClassVar
 
 import numpy as np
 
 from ..errors import SceneError
 from ..inputs import read_text_file
 from .ops import Ops, piecewise_linear
-from .table import Rule, check_number
+from .table import Rule, Table, check_number
 
 #: Points a characteristic may have at most: the symbolic user function is a chain of one selection per point.
 MAX_POINTS = 2_000
@@ -246,3 +248,72 @@ def check_unique_name(scene, table, key: str) -> None:
 def scene_key(scene, table, default: str) -> str:
     """``table``'s key in ``scene`` (``tabulated_spring`` or ``tabulated_spring.1``)."""
     return next((key for key, other in scene.tables() if other is table), default)
+
+
+@dataclass(frozen=True)
+class CharacteristicTable(Table):
+    """The scene table of a tabulated characteristic (a base: :mod:`.tabulated_spring`, :mod:`.tabulated_damper`).
+
+    Fields ``name``, ``points`` (inline pairs) or ``file`` (a CSV beside the scene); a subclass names its TABLE,
+    ``COLUMNS`` (the CSV header), ``UNITS`` (of a point), the plausible extent ``MAX_EXTENT`` with its
+    ``QUANTITY``, ``UNIT`` and ``SLIP`` hint (a UnitWarning beyond it), its ``CONNECTOR`` class, and its own
+    rules in :meth:`check_pairs`.
+    """
+
+    name: str
+    points: Any = None
+    file: str | None = None
+    MANY: ClassVar[bool] = True
+    SINCE_VERSION: ClassVar[int] = 2
+    COLUMNS: ClassVar[str] = ""
+    UNITS: ClassVar[tuple[str, str]] = ("", "")
+    MAX_EXTENT: ClassVar[float] = math.inf
+    QUANTITY: ClassVar[str] = ""
+    UNIT: ClassVar[str] = ""
+    SLIP: ClassVar[str] = ""
+    CONNECTOR: ClassVar[type] = type(None)
+
+    def __post_init__(self):
+        super().__post_init__()
+        key = self.TABLE
+        check_name(key, self.name)
+        pairs = resolve_points(self, key, self.COLUMNS, self.UNITS)
+        where = self._where(key)
+        self.check_pairs(pairs, where, lambda i: where if self.file is not None else f"{where}.{i}")
+        if self.file is None:
+            object.__setattr__(self, "points", pairs)
+        object.__setattr__(self, "_pairs", pairs)
+
+    def _where(self, key: str) -> str:
+        return f"{key}.file" if self.file is not None else f"{key}.points"
+
+    def check_pairs(self, pairs, where: str, item) -> None:
+        """The element's own rules on its points (SceneError naming ``where``, or ``item(i)`` for point i)."""
+
+    @property
+    def pairs(self) -> tuple[tuple[float, float], ...]:
+        """The points as given inline or read from the file."""
+        return self._pairs
+
+    def to_mapping(self) -> dict[str, Any]:
+        out: dict[str, Any] = {"name": self.name}
+        if self.file is not None:
+            out["file"] = self.file
+        else:
+            out["points"] = [list(p) for p in self.pairs]
+        return out
+
+    def check_in_scene(self, scene, key: str) -> None:
+        check_unique_name(scene, self, key)
+
+    def implausible(self, key: str) -> list[tuple[str, str]]:
+        """A table reaching beyond ``MAX_EXTENT`` (a UnitWarning: ``mbs_models.scene.plausibility``)."""
+        return implausible_extent(Characteristic(self.pairs), self._where(key), self.MAX_EXTENT, self.QUANTITY,
+                                  self.UNIT, self.SLIP)
+
+    def bodies(self, scene, name: str) -> list:
+        return []
+
+    def connectors(self, scene, name: str) -> list:
+        return [self.CONNECTOR(self.name, name, self, scene_key(scene, self, self.TABLE))]
+

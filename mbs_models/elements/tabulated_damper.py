@@ -26,15 +26,13 @@ UnitWarning naming the key (velocities in mm/s?).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import ClassVar
 
 from ..errors import SceneError
 from .barrel import BARREL
-from .characteristic import (Characteristic, check_name, check_unique_name, implausible_extent, resolve_points,
-                             scene_key, warn_outside)
+from .characteristic import Characteristic, CharacteristicTable, warn_outside
 from .connector import GROUND, Connector
 from .ops import NUMPY_OPS, Ops
-from .table import Table
 
 #: The fastest plausible velocity (m/s) a damper table reaches: free-recoil velocities stay below 30 m/s
 #: (DESIGN.md "Unit slips"); a table in mm/s reaches 1000 times further.
@@ -44,7 +42,7 @@ UNITS = ("velocity m/s", "force N")
 
 
 @dataclass(frozen=True)
-class TabulatedDamper(Table):
+class TabulatedDamper(CharacteristicTable):
     """A damper ground -> barrel with a tabulated characteristic F(v) (module docstring).
 
     Attributes
@@ -54,24 +52,15 @@ class TabulatedDamper(Table):
     file: instead of ``points``, a CSV file ``velocity,force`` (one header line), relative to the scene file.
     """
 
-    name: str
-    points: Any = None
-    file: str | None = None
     TABLE: ClassVar[str] = "tabulated_damper"
-    MANY: ClassVar[bool] = True
     ORDER: ClassVar[int] = 45
-    SINCE_VERSION: ClassVar[int] = 2
+    COLUMNS: ClassVar[str] = "velocity,force"
+    UNITS: ClassVar[tuple[str, str]] = UNITS
+    MAX_EXTENT: ClassVar[float] = MAX_VELOCITY
+    QUANTITY, UNIT, SLIP = "velocity", "m/s", "velocities in mm/s?"
 
-    def __post_init__(self):
-        super().__post_init__()
-        key = self.TABLE
-        check_name(key, self.name)
-        pairs = resolve_points(self, key, "velocity,force", UNITS)
-        where = f"{key}.file" if self.file is not None else f"{key}.points"
-
-        def item(i: int) -> str:
-            return where if self.file is not None else f"{where}.{i}"
-
+    def check_pairs(self, pairs, where: str, item) -> None:
+        """The rest point (0, 0) listed; passive (F v >= 0) at every point and on the extrapolated end segments."""
         if (0.0, 0.0) not in pairs:
             raise SceneError(where, "must list the rest point [0.0, 0.0]: a damper has no force at rest (F(0) = 0)")
         for i, (v, f) in enumerate(pairs):
@@ -83,37 +72,6 @@ class TabulatedDamper(Table):
             if slope < 0:
                 raise SceneError(item(i), f"the end segment's slope must be >= 0 N s/m (it is extrapolated beyond the "
                                           f"table, where a falling force would turn active), got {slope:g} N s/m")
-        if self.file is None:
-            object.__setattr__(self, "points", pairs)
-        object.__setattr__(self, "_pairs", pairs)
-
-    @property
-    def pairs(self) -> tuple[tuple[float, float], ...]:
-        """The points ``(v m/s, F N)`` as given inline or read from the file."""
-        return self._pairs
-
-    def to_mapping(self) -> dict[str, Any]:
-        out: dict[str, Any] = {"name": self.name}
-        if self.file is not None:
-            out["file"] = self.file
-        else:
-            out["points"] = [list(p) for p in self.pairs]
-        return out
-
-    def check_in_scene(self, scene, key: str) -> None:
-        check_unique_name(scene, self, key)
-
-    def implausible(self, key: str) -> list[tuple[str, str]]:
-        """A table reaching beyond MAX_VELOCITY (a UnitWarning: ``mbs_models.scene.plausibility``)."""
-        where = f"{key}.file" if self.file is not None else f"{key}.points"
-        return implausible_extent(Characteristic(self.pairs), where, MAX_VELOCITY, "velocity", "m/s",
-                                  "velocities in mm/s?")
-
-    def bodies(self, scene, name: str) -> list:
-        return []
-
-    def connectors(self, scene, name: str) -> list[Connector]:
-        return [TabulatedDamperConnector(self.name, name, self, scene_key(scene, self, self.TABLE))]
 
 
 class TabulatedDamperConnector(Connector):
@@ -159,3 +117,6 @@ def add_tabulated_damper(mbs, marker_ground, marker_barrel, damper: TabulatedDam
     connector = TabulatedDamperConnector(damper.name, damper.name, damper)
     connector.add_items(mbs, marker_ground, marker_barrel, user_functions)
     return connector
+
+
+TabulatedDamper.CONNECTOR = TabulatedDamperConnector

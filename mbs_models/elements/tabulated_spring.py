@@ -35,15 +35,13 @@ with its steepest segment.  A table reaching beyond 5 m (:data:`MAX_STROKE`) get
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import ClassVar
 
 from ..errors import SceneError
 from .barrel import BARREL
-from .characteristic import (Characteristic, check_name, check_unique_name, implausible_extent, resolve_points,
-                             scene_key, warn_outside)
+from .characteristic import Characteristic, CharacteristicTable, warn_outside
 from .connector import GROUND, Connector
 from .ops import Ops
-from .table import Table
 
 #: The longest plausible stroke (m) a spring table reaches: real recoil strokes are below 1.5 m; a table in mm
 #: reaches 1000 times further.
@@ -53,7 +51,7 @@ UNITS = ("displacement m", "force N")
 
 
 @dataclass(frozen=True)
-class TabulatedSpring(Table):
+class TabulatedSpring(CharacteristicTable):
     """A spring ground -> barrel with a tabulated characteristic F(x) (module docstring).
 
     Attributes
@@ -63,59 +61,22 @@ class TabulatedSpring(Table):
     file: instead of ``points``, a CSV file ``displacement,force`` (one header line), relative to the scene file.
     """
 
-    name: str
-    points: Any = None
-    file: str | None = None
     TABLE: ClassVar[str] = "tabulated_spring"
-    MANY: ClassVar[bool] = True
     ORDER: ClassVar[int] = 44
-    SINCE_VERSION: ClassVar[int] = 2
+    COLUMNS: ClassVar[str] = "displacement,force"
+    UNITS: ClassVar[tuple[str, str]] = UNITS
+    MAX_EXTENT: ClassVar[float] = MAX_STROKE
+    QUANTITY, UNIT, SLIP = "displacement", "m", "displacements in mm?"
 
-    def __post_init__(self):
-        super().__post_init__()
-        key = self.TABLE
-        check_name(key, self.name)
-        pairs = resolve_points(self, key, "displacement,force", UNITS)
-        where = f"{key}.file" if self.file is not None else f"{key}.points"
+    def check_pairs(self, pairs, where: str, item) -> None:
+        """The rest point (0, 0) listed; F never decreasing with x."""
         if (0.0, 0.0) not in pairs:
             raise SceneError(where, "must list the rest point [0.0, 0.0]: the barrel starts at rest at x = 0 m, "
                                     "where the spring must be relaxed (a preload needs a [recuperator])")
         for i in range(1, len(pairs)):
             if pairs[i][1] < pairs[i - 1][1]:
-                item = where if self.file is not None else f"{where}.{i}"
-                raise SceneError(item, f"the force must not decrease with x (>= {pairs[i - 1][1]:g} N), got "
-                                       f"{pairs[i][1]:g} N at x = {pairs[i][0]:g} m")
-        if self.file is None:
-            object.__setattr__(self, "points", pairs)
-        object.__setattr__(self, "_pairs", pairs)
-
-    @property
-    def pairs(self) -> tuple[tuple[float, float], ...]:
-        """The points ``(x m, F N)`` as given inline or read from the file."""
-        return self._pairs
-
-    def to_mapping(self) -> dict[str, Any]:
-        out: dict[str, Any] = {"name": self.name}
-        if self.file is not None:
-            out["file"] = self.file
-        else:
-            out["points"] = [list(p) for p in self.pairs]
-        return out
-
-    def check_in_scene(self, scene, key: str) -> None:
-        check_unique_name(scene, self, key)
-
-    def implausible(self, key: str) -> list[tuple[str, str]]:
-        """A table reaching beyond MAX_STROKE (a UnitWarning: ``mbs_models.scene.plausibility``)."""
-        where = f"{key}.file" if self.file is not None else f"{key}.points"
-        return implausible_extent(Characteristic(self.pairs), where, MAX_STROKE, "displacement", "m",
-                                  "displacements in mm?")
-
-    def bodies(self, scene, name: str) -> list:
-        return []
-
-    def connectors(self, scene, name: str) -> list[Connector]:
-        return [TabulatedSpringConnector(self.name, name, self, scene_key(scene, self, self.TABLE))]
+                raise SceneError(item(i), f"the force must not decrease with x (>= {pairs[i - 1][1]:g} N), got "
+                                          f"{pairs[i][1]:g} N at x = {pairs[i][0]:g} m")
 
 
 class TabulatedSpringConnector(Connector):
@@ -171,3 +132,6 @@ def add_tabulated_spring(mbs, marker_ground, marker_barrel, spring: TabulatedSpr
     connector = TabulatedSpringConnector(spring.name, spring.name, spring)
     connector.add_items(mbs, marker_ground, marker_barrel, user_functions)
     return connector
+
+
+TabulatedSpring.CONNECTOR = TabulatedSpringConnector
