@@ -76,14 +76,15 @@ def _numbers(value) -> bool:
 
 
 def current(scene, key: str):
-    """The value at ``key`` in ``scene`` (attribute path; ``absorber.N`` indexes the absorbers)."""
+    """The value at ``key`` in ``scene`` (attribute path; ``absorber.N`` indexes the absorbers, and likewise
+    every array of tables)."""
     parts = key.split(".")
-    if parts[0] == "absorber":
-        absorbers = scene.absorbers
+    array = getattr(scene, parts[0] + "s", None)   # an array of tables: [[absorber]], [[tabulated_spring]]
+    if isinstance(array, tuple):
         if len(parts) > 1 and parts[1].isdigit():
-            target, parts = absorbers[int(parts[1])], parts[2:]
+            target, parts = array[int(parts[1])], parts[2:]
         else:
-            target, parts = absorbers[0], parts[1:]
+            target, parts = array[0], parts[1:]
     else:
         target, parts = getattr(scene, parts[0]), parts[1:]
     for part in parts:

@@ -38,13 +38,18 @@ from ..inputs import check_toml_nesting
 from .container import Conventions, Scene
 
 _SINGLE_TABLES: list[str] = []
+#: Arrays of tables other than the absorbers (``[[tabulated_spring]]``): table name -> the scene's attribute.
+_ARRAY_TABLES: dict[str, str] = {}
 _TOP_LEVEL: list[str] = []
 
 
 def _refresh_views() -> None:
     """The keys a dotted override may start with (again after :func:`~mbs_models.register_element`)."""
     _SINGLE_TABLES[:] = [name for name, cls in ELEMENT_TABLES.items() if not cls.MANY]
-    _TOP_LEVEL[:] = sorted(["name", "conventions", "contact", "absorber", *_SINGLE_TABLES])
+    _ARRAY_TABLES.clear()
+    _ARRAY_TABLES.update((name, name + "s") for name, cls in ELEMENT_TABLES.items()
+                         if cls.MANY and name != "absorber")
+    _TOP_LEVEL[:] = sorted(["name", "conventions", "contact", "absorber", *_SINGLE_TABLES, *_ARRAY_TABLES])
 
 
 _refresh_views()
@@ -92,6 +97,20 @@ def resolve_key(scene: Scene, key: str) -> tuple[str, int | None, tuple[str, ...
         if head == "contact":
             rest = ["contact", *rest]
         return "absorbers", index, _field_path(absorbers[index], rest, key)
+    if head in _ARRAY_TABLES:  # an array of tables: head.N.field, or head.field when the scene has one
+        items = getattr(scene, _ARRAY_TABLES[head])
+        if rest and rest[0].isdigit():
+            index = int(rest[0])
+            if index >= len(items):
+                raise SceneError(key, f"the scene has {len(items)} [[{head}]] table(s): index {index} does not "
+                                      f"exist (indices start at 0)")
+            rest = rest[1:]
+        elif len(items) != 1:
+            raise SceneError(key, f"the scene has no [[{head}]] table to change" if not items else
+                             f"the scene has {len(items)} [[{head}]] tables: name one as {head}.N.{'.'.join(rest)}")
+        else:
+            index = 0
+        return _ARRAY_TABLES[head], index, _field_path(items[index], rest, key)
     if head in _SINGLE_TABLES:
         table = getattr(scene, head)
         if table is None:
@@ -173,7 +192,7 @@ def apply_overrides(scene: Scene, overrides: Mapping[str, Any]) -> Scene:
         node[path[-1]] = value
         group["keys"].setdefault((), _prefix(key, len(path)) or _canonical(scene, table, index))
     conventions = scene.conventions
-    absorbers = list(scene.absorbers)
+    arrays: dict[str, list] = {}   # "absorbers", "tabulated_springs": the changed arrays of tables
     tables: dict[str, Any] = {}
     for (table, index), group in groups.items():
         if table == "conventions":
@@ -181,13 +200,13 @@ def apply_overrides(scene: Scene, overrides: Mapping[str, Any]) -> Scene:
                 conventions = replace(conventions, **group["tree"])
             except SceneError as exc:
                 raise exc from None
-        elif table == "absorbers":
-            absorbers[index] = _rebuild(absorbers[index], group["tree"], group["keys"], ())
+        elif index is not None:
+            items = arrays.setdefault(table, list(getattr(scene, table)))
+            items[index] = _rebuild(items[index], group["tree"], group["keys"], ())
         else:
             tables[table] = _rebuild(getattr(scene, table), group["tree"], group["keys"], ())
     changes: dict[str, Any] = dict(tables)
-    if any(table == "absorbers" for table, _ in groups):
-        changes["absorbers"] = tuple(absorbers)
+    changes.update((table, tuple(items)) for table, items in arrays.items())
     if conventions is not scene.conventions:
         changes["conventions"] = conventions
     if name != scene.name:
@@ -197,8 +216,9 @@ def apply_overrides(scene: Scene, overrides: Mapping[str, Any]) -> Scene:
 
 def _canonical(scene: Scene, table: str, index: int | None) -> str:
     """The key of a table as the file names it (``absorber``, ``absorber.1``, ``recoil_brake``)."""
-    if table == "absorbers":
-        return "absorber" if len(scene.absorbers) == 1 else f"absorber.{index}"
+    if index is not None:  # an array of tables: "absorbers" -> absorber, absorber.1
+        head = table[:-1]
+        return head if len(getattr(scene, table)) == 1 else f"{head}.{index}"
     return table
 
 

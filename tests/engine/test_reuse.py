@@ -66,7 +66,8 @@ VARIANTS = {
 def _variant(name: str, scene):
     changes = VARIANTS.get(name)
     if changes is None:
-        changes = {"contact.gap": 0.02} if scene.has_absorber else {"recoil_spring.stiffness": 3.0e5}
+        changes = ({"contact.gap": 0.02} if scene.has_absorber else
+                   {"recoil_spring.stiffness": 3.0e5} if scene.recoil_spring is not None else {})
     return scene.with_changes(**{"barrel.mass": scene.barrel.mass * 1.07, **changes})
 
 

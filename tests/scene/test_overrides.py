@@ -176,3 +176,25 @@ def test_a_value_nested_1000_deep_is_one_scene_error_naming_the_key():
     with pytest.raises(SceneError, match="nested more than 32 deep") as info:
         parse_value("[" * 1000 + "]" * 1000, "contact.gap")
     assert info.value.key == "contact.gap"
+
+
+def test_every_array_of_tables_takes_dotted_keys():
+    """[[tabulated_damper]] like [[absorber]]: ``tabulated_damper.points`` when the scene has one, ``.N.`` to name
+    one of several; an index beyond the array, or a bad table, is one SceneError naming the key (the slow
+    extreme-value test set such keys and found them unknown)."""
+    from mbs_models import load_scene
+    from mbs_models.scenes import scene_path
+
+    scene = load_scene(scene_path("tabulated_damper"))
+    table = [[-1.0, -10.0], [0.0, 0.0], [1.0, 10.0]]
+    changed = apply_overrides(scene, {"tabulated_damper.points": table})
+    assert changed.tabulated_dampers[0].pairs == tuple(tuple(p) for p in table)
+    assert apply_overrides(scene, {"tabulated_damper.0.points": table}) == changed
+    with pytest.raises(SceneError) as info:
+        apply_overrides(scene, {"tabulated_damper.2.points": table})
+    assert info.value.key == "tabulated_damper.2.points" and "index 2 does not exist" in info.value.message
+    with pytest.raises(SceneError) as info:
+        apply_overrides(scene, {"tabulated_damper.points": [[-1.0, 10.0], [0.0, 0.0]]})
+    assert info.value.key.startswith("tabulated_damper.points") and "passive" in info.value.message
+    with pytest.raises(SceneError, match="no \\[\\[tabulated_spring\\]\\] table"):
+        apply_overrides(scene, {"tabulated_spring.points": table})
