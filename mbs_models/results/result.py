@@ -9,6 +9,7 @@ import numpy as np
 
 from ..elements.barrel import BARREL
 from ..stop_reason import StopReason
+from . import element_outputs
 
 #: Every metric a run can report (and prove final with ``stop_when_final``).
 ALL_METRICS = ("max_barrel_displacement", "peak_contact_force", "max_absorber_velocity", "impacts",
@@ -83,6 +84,10 @@ class Result:
     with their times; ``impacts`` (all absorbers' impacts in time order); ``dissipated_energy`` (J per
     dissipating connector at the end time); :meth:`absorbers`, :meth:`stops`, :meth:`energy` per element.
 
+    Declared outputs (:mod:`mbs_models.elements.declaration`): ``element_histories`` and ``element_metrics``,
+    ``{element: {name: value}}``, the histories and metrics elements declare (a burst's ``shots``); a declared
+    metric is also an attribute by its name when one element of the run declares it (``result.shots``).
+
     Window: the histories cover ``[0, end_time]`` s.  ``requested_end_time`` is what was asked for;
     ``end_time`` is smaller only when ``simulate(..., stop_when_final=...)`` stopped the solve because
     the named metrics were proven final (``stop_reason == "metrics_final"``, see
@@ -127,7 +132,8 @@ class Result:
     kinetic_energy_histories: dict[str, np.ndarray] = field(repr=False, default_factory=dict)
     element_of: dict[str, str] = field(repr=False, default_factory=dict)
     work_histories: dict[str, np.ndarray] = field(repr=False, default_factory=dict)
-    shots: list[dict[str, Any]] | None = None
+    element_histories: dict[str, dict[str, np.ndarray]] = field(repr=False, default_factory=dict)
+    element_metrics: dict[str, dict[str, Any]] = field(default_factory=dict)
     wall_time: float = 0.0
     timings: dict[str, float] = field(default_factory=dict)
     steps: int = 0
@@ -136,6 +142,16 @@ class Result:
     final_metrics: tuple[str, ...] = ALL_METRICS
     rest_time: float | None = None
     rest_tolerance: float | None = None
+
+    def __getattr__(self, name: str):
+        """A metric an element declares, by its name (``result.shots`` of a burst): the run's one element that
+        declares it (None if none of the run's does but a registered element could; see
+        :func:`~mbs_models.results.element_outputs.lookup`)."""
+        if name.startswith("_") or "element_metrics" not in self.__dict__:  # (copy, pickle: before the fields)
+            raise AttributeError(name)
+        from .element_outputs import lookup
+
+        return lookup(self, name)
 
     def __post_init__(self):
         # (while it is built: frozen from then on)
@@ -320,21 +336,20 @@ class Result:
             "dissipated_energy": dict(self.dissipated_energy),
             "energy": self.energy(),
             **self._firing_metrics(),
+            **element_outputs.json_entries(self),
             **self._rest_metrics(),
             "steps": self.steps,
             "wall_time": self.wall_time,
         }
 
     def _firing_metrics(self) -> dict[str, Any]:
-        """``pulse_impulse`` (N s, with a breech-force pulse), ``shots`` (with a burst), ``work`` (J, with
-        external inputs): only for scenes that have them (version-1 keys stay as they were)."""
+        """``pulse_impulse`` (N s, with a breech-force pulse), ``work`` (J, with external inputs): only for scenes
+        that have them (version-1 keys stay as they were)."""
         out: dict[str, Any] = {}
         firing = getattr(self.scene, "firing", None)
         pulse = getattr(firing, "pulse", None)
         if pulse is not None:
             out["pulse_impulse"] = firing.shot_momentum
-        if self.shots is not None:
-            out["shots"] = [dict(shot) for shot in self.shots]
         if self.work_histories:
             out["work"] = {name: float(history[-1]) for name, history in self.work_histories.items()}
         return out
@@ -402,14 +417,7 @@ class Result:
         firing = self._firing_metrics()
         if "pulse_impulse" in firing:
             lines.append(f"  breech pulse impulse     {firing['pulse_impulse']:.1f} N s per shot")
-        for shot in firing.get("shots", []):
-            back = "never back in battery" if shot["time_to_battery"] is None else \
-                f"in battery {shot['time_to_battery']:.3f} s after it"
-            state = "" if shot["in_battery_at_next_shot"] is None else \
-                (", in battery at the next shot" if shot["in_battery_at_next_shot"] else
-                 f", OUT of battery at the next shot (x = {shot['position_at_next_shot'] * 1e3:.1f} mm)")
-            lines.append(f"  shot {shot['shot']:<3d} at {shot['time']:7.3f} s  max {shot['max_barrel_displacement']:.6f} m, "
-                         f"{back}{state}")
+        lines += element_outputs.summary_lines(self)
         supplied = self.kinetic_energy_history[0] + self.stored_energy_history[0] + sum(firing.get("work", {}).values())
         lines.append(f"  energy dissipated        {self.total_dissipated_energy:.2f} J of "
                      f"{supplied:.2f} J" + (" (with the work of the inputs)" if "work" in firing else ""))

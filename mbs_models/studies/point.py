@@ -3,7 +3,7 @@
 :func:`simulate_scene` is the one place where a sweep calls :func:`~mbs_models.simulate` (the scene-list
 sweeps of :mod:`.sweep` and the grid sweeps both go through it).  :func:`evaluate_point` applies the
 overrides (:func:`~mbs_models.scene.overrides.apply_overrides`), simulates and returns the row: the
-parameters, every scalar metric (:func:`metric_columns`), ``wall_time`` (s), ``status`` (``"ok"`` or the
+parameters, every scalar metric (:func:`metric_columns`, with those the elements declare), ``wall_time`` (s), ``status`` (``"ok"`` or the
 error's class) and ``error`` (its message on one line, None when ok).  Whatever goes wrong at a point is
 recorded in its row, and the sweep goes on: a :class:`~mbs_models.errors.SceneError` (an invalid
 combination of values), a :class:`~mbs_models.errors.SimulationError` (a failed solve) and any other
@@ -29,6 +29,7 @@ from dataclasses import dataclass
 from typing import Any, Mapping, Sequence
 
 from ..engine.accuracy import SolverSettings
+from ..results import element_outputs
 from ..scene import Scene
 from ..scene.overrides import apply_overrides
 
@@ -100,6 +101,7 @@ def metric_columns(scene: Scene) -> list[str]:
     if len(scene.absorbers) > 1:
         columns += [f"absorber.{i}.{m}" for i in range(len(scene.absorbers)) for m in ABSORBER_METRICS]
     columns += [f"{stop}.{m}" for stop in _stops(scene) for m in STOP_METRICS]
+    columns += element_outputs.sweep_columns(scene)  # the metrics elements declare (``<element>.<name>``)
     return columns + list(RUN_COLUMNS)
 
 
@@ -119,6 +121,7 @@ def result_row(result, scene: Scene) -> dict[str, Any]:
         impacts = entry.get("impacts")
         row[f"{stop}.impacts"] = None if impacts is None else len(impacts)
         row[f"{stop}.dissipated_energy"] = entry.get("dissipated_energy")
+    row.update(element_outputs.sweep_row(result))
     row.update(initial_velocity=scene.initial_velocity, end_time=result.end_time,
                stop_reason=str(result.stop_reason), steps=result.steps)  # the StopReason's text: tables hold strings
     return row
