@@ -19,6 +19,12 @@ them::
   ``<element>.<name>`` when ``column`` (a finite number, N, m, s...), and as lines
   of ``recoil run``'s summary (``summary(value)``, default one line ``<element> <name> value unit``).
 
+An element's roles (``ROLES``, a tuple of :data:`ABSORBER`, :data:`END_STOP`) say what it is to the results: the
+bodies and contacts of an :data:`ABSORBER` are the absorbers of the version-1 metrics (``peak_contact_force``,
+``max_absorber_velocity``, ``impacts``; ``Result.absorbers()``); the contacts of an :data:`END_STOP` are its
+stops (``Result.stops()``, the sweep columns ``<stop>.peak_contact_force`` ...).  A connector says itself whether it
+is a contact (``Connector.is_contact``: its force history and impacts are outputs).
+
 A metric describes the window simulated; after an early stop (``stop_when_final``) it is None unless it says
 ``window=True`` (a value that is meaningful for any window, such as the shots fired in it).
 """
@@ -27,6 +33,17 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from typing import Any, Callable
+
+
+#: The role of an element whose bodies are absorbers (and whose contacts are the absorbers' contacts).
+ABSORBER = "absorber"
+#: The role of an element whose contacts are end stops (contacts the barrel hits, on the ground).
+END_STOP = "end_stop"
+
+
+def elements_with(scene, role: str) -> list[str]:
+    """The names of the elements of ``scene`` that declare ``role`` (their table's ``ROLES``), in element order."""
+    return [name for name, table in scene.elements() if role in getattr(table, "ROLES", ())]
 
 
 @dataclass(frozen=True)

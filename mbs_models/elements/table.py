@@ -147,6 +147,8 @@ class Table:
     RULES: field name -> :class:`Rule` for numeric fields (``None`` values are skipped: optional fields).
     REQUIRED: keys a file must give (default: the fields without a default value).
     NESTED: field name -> Table class of a sub-table (``[absorber.contact]``).
+    ROLES: what the element is to the results (:data:`~mbs_models.elements.declaration.ABSORBER`,
+        :data:`~mbs_models.elements.declaration.END_STOP`); none by default.
     OUTPUTS: the element's declared histories and metrics (:mod:`~mbs_models.elements.declaration`); none by
         default.
     """
@@ -157,6 +159,7 @@ class Table:
     SINCE_VERSION: ClassVar[int] = 1
     RULES: ClassVar[dict[str, Rule]] = {}
     NESTED: ClassVar[dict[str, type]] = {}
+    ROLES: ClassVar[tuple[str, ...]] = ()
     OUTPUTS: ClassVar[Outputs] = NO_OUTPUTS
 
     def __post_init__(self):

@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 
 from ..elements.barrel import BARREL
+from ..elements.declaration import ABSORBER, END_STOP, elements_with
 from ..stop_reason import StopReason
 from . import element_outputs
 
@@ -174,13 +175,15 @@ class Result:
         return self.accelerations[BARREL]
 
     def _single_absorber(self) -> str | None:
-        names = [name for name in self.positions if name != BARREL]
+        names = self.absorber_names
         return names[0] if len(names) == 1 else None
 
     @property
     def absorber_names(self) -> list[str]:
-        """The absorbers' (bodies') names."""
-        return [name for name in self.positions if name != BARREL]
+        """The absorbers' (bodies') names: the bodies of the elements whose role is an absorber
+        (:data:`~mbs_models.elements.declaration.ABSORBER`)."""
+        absorbers = set(elements_with(self.scene, ABSORBER))
+        return [name for name in self.positions if self.element_of.get(name, name) in absorbers]
 
     @property
     def absorber_position(self) -> np.ndarray | None:
@@ -275,10 +278,13 @@ class Result:
         return out
 
     def stops(self) -> list[dict[str, Any]]:
-        """Per end stop: ``name``, ``peak_contact_force`` (N) and time, ``impacts``, ``dissipated_energy`` (J)."""
+        """Per end stop (a contact of an element whose role is
+        :data:`~mbs_models.elements.declaration.END_STOP`): ``name``, ``peak_contact_force`` (N) and time,
+        ``impacts``, ``dissipated_energy`` (J)."""
         out = []
+        stops = set(elements_with(self.scene, END_STOP))
         for contact in self.contacts.values():
-            if contact.element in self.absorber_names:
+            if contact.element not in stops:
                 continue
             entry = contact.to_dict()
             entry["dissipated_energy"] = self.dissipated_energy.get(contact.name)

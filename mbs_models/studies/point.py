@@ -28,6 +28,7 @@ import time
 from dataclasses import dataclass
 from typing import Any, Mapping, Sequence
 
+from ..elements.declaration import END_STOP, elements_with
 from ..engine.accuracy import SolverSettings
 from ..results import element_outputs
 from ..scene import Scene
@@ -43,7 +44,7 @@ SCALAR_METRICS = (
 )
 #: Per absorber (scenes with several), as ``absorber.N.<metric>``.
 ABSORBER_METRICS = ("peak_contact_force", "max_absorber_velocity", "impacts")
-#: Per end stop (a contact with the ground that is no absorber), as ``<element name>.<metric>``.
+#: Per end stop (an element whose role is an end stop), as ``<element name>.<metric>``.
 STOP_METRICS = ("peak_contact_force", "impacts", "dissipated_energy")
 #: Run information after the metrics: the barrel's initial velocity (m/s), the simulated end time (s, less
 #: than asked with an early stop), why the run ended, the solver's steps.
@@ -87,12 +88,9 @@ def simulate_scene(scene: Scene, settings: PointSettings):
 
 
 def _stops(scene: Scene) -> list[str]:
-    """Element names of the scene's end stops (contacts with the ground that are no absorbers)."""
-    from ..elements.absorber import Absorber
-    from ..elements.contact_laws import LawFields
-
-    return [name for name, table in scene.elements()
-            if isinstance(table, LawFields) and not isinstance(table, Absorber)]
+    """Element names of the scene's end stops (the elements whose role is
+    :data:`~mbs_models.elements.declaration.END_STOP`)."""
+    return elements_with(scene, END_STOP)
 
 
 def metric_columns(scene: Scene) -> list[str]:
