@@ -113,6 +113,22 @@ def sweep_row(result) -> dict[str, Any]:
             for element, metric in metric_specs(result.scene) if metric.column}
 
 
+def declared_column_unit(column: str) -> str | None:
+    """The SI unit of a sweep column ``<element>.<name>`` that is a metric some registered element declares (a
+    column metric ``name`` of a table that has no field ``name``: ``progressive_spring.peak_force``, never the
+    parameter ``progressive_spring.cubic_stiffness``); None for any other column."""
+    from ..elements import TABLES
+
+    if "." not in column:
+        return None
+    name = column.rsplit(".", 1)[-1]
+    for table in TABLES.values():
+        for metric in getattr(table, "OUTPUTS", NO_OUTPUTS).metrics:
+            if metric.column and metric.name == name and name not in table.field_names():
+                return metric.unit
+    return None
+
+
 def lookup(result, name: str):
     """The declared metric ``name`` of the run's one element that declares it; None when no element of the run
     declares it but a registered element could (``result.shots`` of a scene without a burst); AttributeError when

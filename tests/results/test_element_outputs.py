@@ -101,3 +101,19 @@ def test_lookup_by_name():
     twice = SimpleNamespace(element_metrics={"a": {"peak": 1.0}, "b": {"peak": 2.0}})
     with pytest.raises(AttributeError, match="2 elements of the run declare a metric 'peak'"):
         element_outputs.lookup(twice, "peak")
+
+
+def test_a_declared_column_is_known_by_its_registered_element(monkeypatch):
+    """A column metric of a registered table is a metric column in its unit; the table's own fields stay parameters;
+    a declared metric without a column (the burst's ``shots``, also a field of ``[burst]``) is no metric column."""
+    from mbs_models.elements.recoil_spring import RecoilSpring
+    from mbs_models.results.sweep_plots import is_metric_column, metric_label
+    from mbs_models.results.units import metric_si_unit
+
+    monkeypatch.setattr(RecoilSpring, "OUTPUTS", OUTPUTS)
+    assert element_outputs.declared_column_unit("recoil_spring.peak") == "m"
+    assert is_metric_column("recoil_spring.peak") and metric_si_unit("recoil_spring.peak") == "m"
+    assert metric_label("recoil_spring.peak") == ("recoil spring.peak [m]", 1.0)
+    assert element_outputs.declared_column_unit("recoil_spring.events") is None  # column=False
+    assert not is_metric_column("recoil_spring.stiffness")
+    assert element_outputs.declared_column_unit("burst.shots") is None and not is_metric_column("burst.shots")
