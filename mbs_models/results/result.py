@@ -400,7 +400,7 @@ class Result:
                          f"{self.time_of_peak_support_force:.5f} s{end_note('peak_support_force')}")
         else:
             lines.append(f"  peak support force       {not_final}")
-        if self.scene.has_absorber:
+        if elements_with(self.scene, ABSORBER):
             if self.peak_contact_force is None:
                 lines.append(f"  peak contact force       {not_final}")
             elif self.time_of_peak_contact_force is None:

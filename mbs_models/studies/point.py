@@ -28,7 +28,7 @@ import time
 from dataclasses import dataclass
 from typing import Any, Mapping, Sequence
 
-from ..elements.declaration import END_STOP, elements_with
+from ..elements.declaration import ABSORBER, END_STOP, elements_with
 from ..engine.accuracy import SolverSettings
 from ..results import element_outputs
 from ..scene import Scene
@@ -42,7 +42,7 @@ SCALAR_METRICS = (
     "max_absorber_velocity", "time_of_max_absorber_velocity",
     "impacts",
 )
-#: Per absorber (scenes with several), as ``absorber.N.<metric>``.
+#: Per absorber (scenes with several elements whose role is an absorber), as ``absorber.N.<metric>``.
 ABSORBER_METRICS = ("peak_contact_force", "max_absorber_velocity", "impacts")
 #: Per end stop (an element whose role is an end stop), as ``<element name>.<metric>``.
 STOP_METRICS = ("peak_contact_force", "impacts", "dissipated_energy")
@@ -96,8 +96,9 @@ def _stops(scene: Scene) -> list[str]:
 def metric_columns(scene: Scene) -> list[str]:
     """The metric columns of a sweep over ``scene`` (its overrides change values, never the elements)."""
     columns = list(SCALAR_METRICS)
-    if len(scene.absorbers) > 1:
-        columns += [f"absorber.{i}.{m}" for i in range(len(scene.absorbers)) for m in ABSORBER_METRICS]
+    absorbers = elements_with(scene, ABSORBER)
+    if len(absorbers) > 1:
+        columns += [f"absorber.{i}.{m}" for i in range(len(absorbers)) for m in ABSORBER_METRICS]
     columns += [f"{stop}.{m}" for stop in _stops(scene) for m in STOP_METRICS]
     columns += element_outputs.sweep_columns(scene)  # the metrics elements declare (``<element>.<name>``)
     return columns + list(RUN_COLUMNS)
@@ -107,7 +108,7 @@ def result_row(result, scene: Scene) -> dict[str, Any]:
     """The metric columns (:func:`metric_columns`) of one result."""
     row: dict[str, Any] = {name: getattr(result, name) for name in SCALAR_METRICS}
     row["impacts"] = None if result.impacts is None else len(result.impacts)
-    if len(scene.absorbers) > 1:
+    if len(elements_with(scene, ABSORBER)) > 1:
         for i, entry in enumerate(result.absorbers()):
             for metric in ABSORBER_METRICS:
                 value = entry[metric]
