@@ -342,20 +342,21 @@ class Result:
             "dissipated_energy": dict(self.dissipated_energy),
             "energy": self.energy(),
             **self._firing_metrics(),
-            **element_outputs.json_entries(self),
             **self._rest_metrics(),
             "steps": self.steps,
             "wall_time": self.wall_time,
         }
 
     def _firing_metrics(self) -> dict[str, Any]:
-        """``pulse_impulse`` (N s, with a breech-force pulse), ``work`` (J, with external inputs): only for scenes
-        that have them (version-1 keys stay as they were)."""
+        """``pulse_impulse`` (N s, with a breech-force pulse), the declared metrics
+        (:func:`~mbs_models.results.element_outputs.json_entries`: a burst's ``shots``), ``work`` (J, with external
+        inputs): only for scenes that have them (version-1 keys stay as they were)."""
         out: dict[str, Any] = {}
         firing = getattr(self.scene, "firing", None)
         pulse = getattr(firing, "pulse", None)
         if pulse is not None:
             out["pulse_impulse"] = firing.shot_momentum
+        out.update(element_outputs.json_entries(self))
         if self.work_histories:
             out["work"] = {name: float(history[-1]) for name, history in self.work_histories.items()}
         return out
