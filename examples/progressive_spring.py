@@ -7,6 +7,10 @@ This one module is the whole element (README, "Adding your own element"):
 * its connector, ground -> barrel, which gives **only its force law**: the stored energy
   ``U = k1 x^2 / 2 + k3 x^4 / 4``, the tangent stiffness and the force bound of the early stop are derived from
   the law by :class:`mbs_models.elements.Connector`;
+* its outputs (``OUTPUTS``, :mod:`mbs_models.elements.declaration`): the spring's force history ``force`` (N,
+  a panel of ``recoil run --plot``, a column of ``--csv``) and its largest magnitude ``peak_force`` (N: in
+  ``Result.element_metrics``, ``recoil run --json`` as ``{"progressive_spring": {"peak_force": ...}}`` and the
+  sweep column ``progressive_spring.peak_force``);
 * its term of the independent reference (:mod:`validation.reference`), written from the equations above and
   registered with :func:`validation.reference.terms.register_term`.
 
@@ -20,8 +24,11 @@ import sys
 from dataclasses import dataclass
 from typing import ClassVar
 
+import numpy as np
+
 from mbs_models import register_element
 from mbs_models.elements import GROUND, Connector, Rule, Table
+from mbs_models.elements.declaration import History, Metric, Outputs
 from validation.reference import model as reference
 from validation.reference.terms import register_term
 
@@ -42,6 +49,10 @@ class ProgressiveSpring(Table):
     ORDER: ClassVar[int] = 25
     SINCE_VERSION: ClassVar[int] = 2
     RULES: ClassVar = {"linear_stiffness": Rule(0.0, unit="N/m"), "cubic_stiffness": Rule(0.0, unit="N/m^3")}
+    #: the spring's force F(x_M) (N) at the output times, and its largest magnitude over the run (N)
+    OUTPUTS: ClassVar = Outputs(
+        histories=(History("force", "N", lambda run: run.force(), panel="spring force [kN]", scale=1e-3),),
+        metrics=(Metric("peak_force", "N", lambda run: float(np.max(np.abs(run.history("force"))))),))
 
     def bodies(self, scene, name: str) -> list:
         return []
@@ -116,4 +127,5 @@ if __name__ == "__main__":  # python examples/progressive_spring.py [scene.toml]
     path = sys.argv[1] if len(sys.argv) > 1 else Path(__file__).with_name("progressive_spring.toml")
     result = simulate(load_scene(path), end_time=3.0)
     print(f"max barrel displacement {result.max_barrel_displacement:.6f} m, "
-          f"peak force on the mount {result.peak_support_force:.1f} N")
+          f"peak force on the mount {result.peak_support_force:.1f} N, "
+          f"peak spring force {result.element_metrics['progressive_spring']['peak_force']:.1f} N")

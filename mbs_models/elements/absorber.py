@@ -35,6 +35,7 @@ from ..errors import SceneError
 from .barrel import BARREL
 from .connector import GROUND, Body, Connector, LinearSpringDamper
 from .contact_laws import Contact, ContactConnector
+from .declaration import ABSORBER
 from .table import Rule, Table, check_choice, check_derived, ieee_power
 
 #: Allowed absorber mounts: ``"barrel"`` is the paper's model (i), ``"ground"`` its model (ii).
@@ -70,6 +71,7 @@ class Absorber(Table):
     RULES: ClassVar = {"mass": Rule(0.0, strict=True, unit="kg"), "stiffness": Rule(0.0, unit="N/m"),
                        "damping": Rule(0.0, unit="N s/m")}
     NESTED: ClassVar = {"contact": Contact}
+    ROLES: ClassVar = (ABSORBER,)  # its body is an absorber, its contact an absorber's contact
 
     def __post_init__(self):
         super().__post_init__()

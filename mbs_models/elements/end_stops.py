@@ -29,6 +29,7 @@ from typing import ClassVar
 from .barrel import BARREL
 from .connector import GROUND, Connector
 from .contact_laws import LAW_RULES, ContactConnector, LawFields
+from .declaration import END_STOP
 from .table import Rule, Table
 
 
@@ -47,6 +48,7 @@ class _Stop(LawFields, Table):
     damping: float | None = None
     minimum_impact_velocity: float | None = None
     SINCE_VERSION: ClassVar[int] = 2
+    ROLES: ClassVar = (END_STOP,)  # its contact is an end stop
 
     def bodies(self, scene, name: str) -> list:
         return []

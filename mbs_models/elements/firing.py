@@ -26,7 +26,9 @@ the scene's conventions may read it differently: ``v0_includes_absorber`` divide
 Table ``[burst]`` (version 2): ``shots`` (>= 1) fired every ``interval`` s; shot k fires at
 ``t_k = k * interval``.  Without a pulse each later shot adds the same velocity jump ``v0`` to the barrel
 (an impulse, :meth:`Burst.impulses`); with a pulse the pulse repeats, shifted by ``t_k``.  A shot that
-fires while the barrel is out of battery is reported, not refused (``Result.shots``).
+fires while the barrel is out of battery is reported, not refused: the burst declares the output ``shots``
+(:func:`shot_outputs`; ``Result.shots``, the key ``shots`` of ``recoil run --json``, a line per shot in the
+summary).
 """
 
 from __future__ import annotations
@@ -45,6 +47,7 @@ from ..errors import SceneError
 from ..inputs import read_text_file
 from .barrel import BARREL
 from .connector import Load
+from .declaration import Metric, Outputs
 from .ops import LinearPieces, NumpyPiecewiseLinear, Ops, piecewise_linear
 from .table import Rule, Table, check_derived, check_number
 
@@ -380,6 +383,69 @@ class BreechForce(Load):
         return self._windows[-1][1]
 
 
+#: A barrel within this distance (m) of its position before the first shot is "in battery".
+BATTERY_TOLERANCE = 1.0e-3
+
+
+def shot_outputs(run) -> list[dict]:
+    """Per shot of the burst, in the window simulated (``run``: an
+    :class:`~mbs_models.elements.declaration.ElementRun`).
+
+    Each entry: ``shot`` (1, 2, ...), ``time`` (s) it fires; ``max_barrel_displacement`` (m) and its
+    time, refined, between this shot and the next (or the end); ``position_at_next_shot`` (m) and
+    ``velocity_at_next_shot`` (m/s): the barrel's state just before the next shot fires, and
+    ``in_battery_at_next_shot`` (within :data:`BATTERY_TOLERANCE` of its position before the first
+    shot), None for the last shot; ``time_to_battery`` (s after the shot): the first return within
+    :data:`BATTERY_TOLERANCE` of battery after the shot's maximum displacement (None if it does not
+    return before the next shot or the end).
+    """
+    from ..results.peaks import refine_crossing, refine_maximum
+
+    s, interp = run.samples, run.interpolant
+    t, x, v = s.time, s.positions[BARREL], s.velocities[BARREL]
+    battery = float(x[0])
+    shots = run.table.shot_times
+    out = []
+    for k, t_shot in enumerate(shots):
+        if t_shot > t[-1]:
+            break
+        lo = int(np.searchsorted(t, t_shot, side="right")) - 1  # the sample after the shot's jump
+        following = shots[k + 1] if k + 1 < len(shots) and shots[k + 1] <= t[-1] else None
+        hi = int(np.searchsorted(t, following, side="left")) if following is not None else len(t) - 1
+        window = slice(lo, hi + 1)
+        x_max, t_max = refine_maximum(t[window], x[window], v[window])
+        entry = {"shot": k + 1, "time": float(t_shot), "max_barrel_displacement": float(x_max),
+                 "time_of_max_barrel_displacement": float(t_max),
+                 "position_at_next_shot": None if following is None else float(x[hi]),
+                 "velocity_at_next_shot": None if following is None else float(v[hi]),
+                 "in_battery_at_next_shot": None if following is None else bool(abs(x[hi] - battery) <= BATTERY_TOLERANCE),
+                 "time_to_battery": None}
+        back = np.flatnonzero((t[window] > t_max) & (np.abs(x[window] - battery) <= BATTERY_TOLERANCE))
+        if len(back):
+            j = lo + int(back[0])
+            crossing = refine_crossing(lambda times: np.abs(interp.x[BARREL](times) - battery) <= BATTERY_TOLERANCE,
+                                       max(t[j - 1], t_max), t[j])
+            entry["time_to_battery"] = float(crossing - t_shot)
+        out.append(entry)
+    return out
+
+
+def shot_lines(shots: list[dict]) -> list[str]:
+    """One line of ``recoil run``'s summary per shot: its time, maximum displacement (m), when it is back in
+    battery and whether it is at the next shot."""
+    lines = []
+    for shot in shots:
+        back = "never back in battery" if shot["time_to_battery"] is None else \
+            f"in battery {shot['time_to_battery']:.3f} s after it"
+        state = "" if shot["in_battery_at_next_shot"] is None else \
+            (", in battery at the next shot" if shot["in_battery_at_next_shot"] else
+             f", OUT of battery at the next shot (x = {shot['position_at_next_shot'] * 1e3:.1f} mm)")
+        lines.append(f"  shot {shot['shot']:<3d} at {shot['time']:7.3f} s  max {shot['max_barrel_displacement']:.6f} m, "
+                     f"{back}{state}")
+    return lines
+
+
+
 @dataclass(frozen=True)
 class Burst(Table):
     """``shots`` shots (integer >= 1) fired every ``interval`` s (> 0): shot k at ``t_k = k * interval``."""
@@ -390,6 +456,10 @@ class Burst(Table):
     ORDER: ClassVar[int] = 6
     SINCE_VERSION: ClassVar[int] = 2
     RULES: ClassVar = {"interval": Rule(0.0, strict=True, unit="s")}
+    #: ``shots`` (:func:`shot_outputs`): at the top level of ``recoil run --json`` (its key before the
+    #: declarations), no sweep column (a list), a line per shot in the summary, for any window simulated.
+    OUTPUTS: ClassVar = Outputs(metrics=(Metric("shots", "-", shot_outputs, json_key="shots", column=False,
+                                                summary=shot_lines, window=True),))
 
     def __post_init__(self):
         if isinstance(self.shots, bool) or not isinstance(self.shots, int) and not (
@@ -428,3 +498,4 @@ class Burst(Table):
         if firing is not None and firing.pulse is not None:
             return []
         return [(t, BARREL, scene.initial_velocity) for t in self.shot_times[1:]]
+

@@ -23,6 +23,7 @@ from dataclasses import dataclass, fields
 from typing import Any, ClassVar, Iterable
 
 from ..errors import SceneError
+from .declaration import NO_OUTPUTS, Outputs
 
 
 @dataclass(frozen=True)
@@ -146,6 +147,10 @@ class Table:
     RULES: field name -> :class:`Rule` for numeric fields (``None`` values are skipped: optional fields).
     REQUIRED: keys a file must give (default: the fields without a default value).
     NESTED: field name -> Table class of a sub-table (``[absorber.contact]``).
+    ROLES: what the element is to the results (:data:`~mbs_models.elements.declaration.ABSORBER`,
+        :data:`~mbs_models.elements.declaration.END_STOP`); none by default.
+    OUTPUTS: the element's declared histories and metrics (:mod:`~mbs_models.elements.declaration`); none by
+        default.
     """
 
     TABLE: ClassVar[str] = ""
@@ -154,6 +159,8 @@ class Table:
     SINCE_VERSION: ClassVar[int] = 1
     RULES: ClassVar[dict[str, Rule]] = {}
     NESTED: ClassVar[dict[str, type]] = {}
+    ROLES: ClassVar[tuple[str, ...]] = ()
+    OUTPUTS: ClassVar[Outputs] = NO_OUTPUTS
 
     def __post_init__(self):
         for name, rule in self.RULES.items():

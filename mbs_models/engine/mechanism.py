@@ -14,6 +14,7 @@ import numpy as np
 
 from ..elements.barrel import BARREL
 from ..elements.connector import GROUND, Body, Connector, Load
+from ..elements.declaration import ABSORBER, END_STOP
 from ..scene import Scene
 
 
@@ -80,20 +81,28 @@ class Mechanism:
         """Every contact connector (absorbers' contacts and stops)."""
         return [c for c in self.connectors if c.is_contact]
 
+    def _of_role(self, role: str) -> set[str]:
+        """The names of the elements that declare ``role`` (:mod:`~mbs_models.elements.declaration`)."""
+        return {e.name for e in self.elements if role in getattr(e.table, "ROLES", ())}
+
     @property
     def absorber_contacts(self) -> list[Connector]:
-        """Contacts between two bodies (wall A against an absorber): the version-1 contact metrics."""
-        return [c for c in self.contacts if GROUND not in (c.a, c.b)]
+        """The contacts of the elements whose role is an absorber (wall A against it): the version-1 contact
+        metrics."""
+        absorbers = self._of_role(ABSORBER)
+        return [c for c in self.contacts if c.element in absorbers]
 
     @property
     def stop_contacts(self) -> list[Connector]:
-        """Contacts between a body and the ground (the end stops)."""
-        return [c for c in self.contacts if GROUND in (c.a, c.b)]
+        """The contacts of the elements whose role is an end stop."""
+        stops = self._of_role(END_STOP)
+        return [c for c in self.contacts if c.element in stops]
 
     @property
     def absorber_bodies(self) -> list[Body]:
-        """Every body but the barrel (the absorbers)."""
-        return self.bodies[1:]
+        """The bodies of the elements whose role is an absorber."""
+        absorbers = self._of_role(ABSORBER)
+        return [b for b in self.bodies if b.element in absorbers]
 
     @property
     def capturing_contacts(self) -> list[Connector]:

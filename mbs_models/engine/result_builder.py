@@ -16,6 +16,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..errors import SimulationError
+from ..results import element_outputs
 from ..results.postprocess import Samples, analyse
 from ..results.result import ContactOutput, Result, total_history
 from ..scene import Scene
@@ -70,6 +71,8 @@ def build_result(record: RunRecord) -> Result:
             raise SimulationError(f"post-processing produced a non-finite {name.replace('_', ' ')}")
     _check_energy_balance(record, fields)
     _drop_unproven(fields, final)
+    if record.stop_reason == StopReason.METRICS_FINAL:  # a shorter window: only window-wide declared metrics hold
+        fields["element_metrics"] = element_outputs.unproven(fields["element_metrics"], record.scene)
     t_end = _time.perf_counter()
     return Result(scene=record.scene, settings=record.settings, end_time=record.end_time, time=samples.time,
                   impact_threshold=record.impact_threshold, requested_end_time=record.requested_end_time,
@@ -118,7 +121,8 @@ def _fields(mechanism: Mechanism, samples: Samples, metrics) -> dict:
         peak_support_force=metrics.peak_support_force, time_of_peak_support_force=metrics.time_of_peak_support_force,
         max_velocities=dict(metrics.max_velocity), dissipated_energy_history=energies.dissipated,
         stored_energy_histories=energies.stored, kinetic_energy_histories=energies.kinetic, element_of=element_of,
-        work_histories=energies.work, shots=metrics.shots)
+        work_histories=energies.work, element_histories=metrics.element_histories,
+        element_metrics=metrics.element_metrics)
 
 
 def _check_energy_balance(record: RunRecord, fields: dict) -> None:

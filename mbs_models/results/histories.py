@@ -2,7 +2,8 @@
 
 ``recoil run --csv FILE`` writes it (:func:`write_histories_csv`).  Columns (SI units, named
 ``"<what> [<unit>]"``): ``time [s]``; every body's position, velocity and acceleration; every contact's
-force and the force on the mount (N, positive in the recoil direction); the energies (J): kinetic per body,
+force and the force on the mount (N, positive in the recoil direction); the histories elements declare
+(``<element> <name> [<unit>]``, :mod:`mbs_models.elements.declaration`); the energies (J): kinetic per body,
 stored and dissipated per connector, the work of every external input, their totals and the
 energy-balance error (:meth:`Result.energy_error`).
 """
@@ -16,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ..outputs import atomic_write_text
+from . import element_outputs
 from .result import Result
 
 
@@ -29,6 +31,9 @@ def history_columns(result: Result) -> dict[str, np.ndarray]:
     for contact in result.contacts.values():
         columns[f"{contact.name} force [N]"] = contact.force
     columns["support force [N]"] = result.support_force
+    for element, _table, outputs in element_outputs.declared(result.scene):
+        for history in outputs.histories:
+            columns[f"{element} {history.name} [{history.unit}]"] = result.element_histories[element][history.name]
     for name, history in result.kinetic_energy_histories.items():
         columns[f"{name} kinetic energy [J]"] = history
     for name, history in result.stored_energy_histories.items():

@@ -16,6 +16,7 @@ from matplotlib.figure import Figure
 
 from ..errors import SceneError
 from ..outputs import atomic_write_bytes
+from . import element_outputs
 from .result import Result
 
 #: One colour per model, used consistently in every figure.
@@ -80,10 +81,12 @@ def plot_result(result: Result, *, title: str | None = None, impact_padding: flo
     """Time histories of one run: positions; contact forces (one line per contact); the force on the
     mount; velocities; and, with an impact, a zoom on the first one (its contact's force and the force on
     the mount over the impact's duration plus ``impact_padding`` of it either side, time in ms).  Every
-    body and contact the scene has, none it lacks."""
+    body and contact the scene has, none it lacks; after the velocities, a panel per ``panel`` of the histories
+    elements declare (:func:`~mbs_models.results.element_outputs.plot_panels`)."""
     contacts = list(result.contacts.values())
     first_impact = result.impacts[0] if result.impacts else None
-    rows = 3 + bool(contacts) + (first_impact is not None)
+    declared = element_outputs.plot_panels(result)
+    rows = 3 + bool(contacts) + len(declared) + (first_impact is not None)
     fig, axes = new_figure(rows, 1, row_height=2.4)
     full = [axes[i, 0] for i in range(rows - (first_impact is not None))]
     for ax in full[1:]:
@@ -124,7 +127,13 @@ def plot_result(result: Result, *, title: str | None = None, impact_padding: flo
         ax.plot(result.time, result.velocities[name], color=_series_colour(i), lw=1.0, label=f"{name} $\\dot x_m$")
     ax.set_ylabel("velocity [m/s]")
     ax.legend(fontsize=8, loc="upper right")
-    ax.set_xlabel("time [s]")
+    for k, (label, lines) in enumerate(declared):
+        ax = axes[row + 2 + k, 0]
+        for i, (name, values) in enumerate(lines):
+            ax.plot(result.time, values, color=_series_colour(i), lw=1.0, label=name)
+        ax.set_ylabel(label)
+        ax.legend(fontsize=8, loc="upper right")
+    full[-1].set_xlabel("time [s]")
     if first_impact is not None:
         _plot_impact_zoom(axes[-1, 0], result, first_impact, impact_padding)
     fig.suptitle(title or result.scene.name, fontsize=11)

@@ -15,7 +15,8 @@ import numpy as np
 from ..elements.barrel import BARREL
 from ..errors import SimulationError
 from .energies import Energies, cumulative_quadrature, energies  # noqa: F401  (re-exported)
-from .peaks import refine_crossing, refine_maximum
+from . import element_outputs
+from .peaks import refine_maximum
 from .refinement import Episodes, refine
 from .result import ALL_METRICS, ContactOutput, Impact
 from .samples import Interpolant, Samples
@@ -61,7 +62,8 @@ class Metrics:
     peak_support_force: float | None = None
     time_of_peak_support_force: float | None = None
     energies: Energies | None = None
-    shots: list[dict] | None = None
+    element_histories: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
+    element_metrics: dict[str, dict] = field(default_factory=dict)
 
 
 def support_force_samples(mechanism, s: Samples) -> np.ndarray:
@@ -166,54 +168,8 @@ def _analyse(mechanism, s: Samples, impact_threshold: float, wanted: tuple[str, 
         metrics.peak_support_force, metrics.time_of_peak_support_force = _support_peak(
             s, metrics.support_force, k_support, refined_support)
     metrics.energies = energies(mechanism, s, interp)
-    metrics.shots = shot_outputs(mechanism, s, interp)
+    metrics.element_histories, metrics.element_metrics = element_outputs.compute(mechanism, s, interp)
     return metrics
-
-
-#: A barrel within this distance (m) of its position before the first shot is "in battery".
-BATTERY_TOLERANCE = 1.0e-3
-
-
-def shot_outputs(mechanism, s: Samples, interp: Interpolant) -> list[dict] | None:
-    """Per shot of a ``[burst]`` (None without one), in the window simulated.
-
-    Each entry: ``shot`` (1, 2, ...), ``time`` (s) it fires; ``max_barrel_displacement`` (m) and its
-    time, refined, between this shot and the next (or the end); ``position_at_next_shot`` (m) and
-    ``velocity_at_next_shot`` (m/s): the barrel's state just before the next shot fires, and
-    ``in_battery_at_next_shot`` (within :data:`BATTERY_TOLERANCE` of its position before the first
-    shot), None for the last shot; ``time_to_battery`` (s after the shot): the first return within
-    :data:`BATTERY_TOLERANCE` of battery after the shot's maximum displacement (None if it does not
-    return before the next shot or the end).
-    """
-    burst = getattr(mechanism.scene, "burst", None)
-    if burst is None:
-        return None
-    t, x, v = s.time, s.positions[BARREL], s.velocities[BARREL]
-    battery = float(x[0])
-    shots = burst.shot_times
-    out = []
-    for k, t_shot in enumerate(shots):
-        if t_shot > t[-1]:
-            break
-        lo = int(np.searchsorted(t, t_shot, side="right")) - 1  # the sample after the shot's jump
-        following = shots[k + 1] if k + 1 < len(shots) and shots[k + 1] <= t[-1] else None
-        hi = int(np.searchsorted(t, following, side="left")) if following is not None else len(t) - 1
-        window = slice(lo, hi + 1)
-        x_max, t_max = refine_maximum(t[window], x[window], v[window])
-        entry = {"shot": k + 1, "time": float(t_shot), "max_barrel_displacement": float(x_max),
-                 "time_of_max_barrel_displacement": float(t_max),
-                 "position_at_next_shot": None if following is None else float(x[hi]),
-                 "velocity_at_next_shot": None if following is None else float(v[hi]),
-                 "in_battery_at_next_shot": None if following is None else bool(abs(x[hi] - battery) <= BATTERY_TOLERANCE),
-                 "time_to_battery": None}
-        back = np.flatnonzero((t[window] > t_max) & (np.abs(x[window] - battery) <= BATTERY_TOLERANCE))
-        if len(back):
-            j = lo + int(back[0])
-            crossing = refine_crossing(lambda times: np.abs(interp.x[BARREL](times) - battery) <= BATTERY_TOLERANCE,
-                                       max(t[j - 1], t_max), t[j])
-            entry["time_to_battery"] = float(crossing - t_shot)
-        out.append(entry)
-    return out
 
 
 def _contact_output(mechanism, connector, s: Samples, episodes: Episodes,

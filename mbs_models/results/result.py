@@ -8,7 +8,9 @@ from typing import Any
 import numpy as np
 
 from ..elements.barrel import BARREL
+from ..elements.declaration import ABSORBER, END_STOP, elements_with
 from ..stop_reason import StopReason
+from . import element_outputs
 
 #: Every metric a run can report (and prove final with ``stop_when_final``).
 ALL_METRICS = ("max_barrel_displacement", "peak_contact_force", "max_absorber_velocity", "impacts",
@@ -83,6 +85,10 @@ class Result:
     with their times; ``impacts`` (all absorbers' impacts in time order); ``dissipated_energy`` (J per
     dissipating connector at the end time); :meth:`absorbers`, :meth:`stops`, :meth:`energy` per element.
 
+    Declared outputs (:mod:`mbs_models.elements.declaration`): ``element_histories`` and ``element_metrics``,
+    ``{element: {name: value}}``, the histories and metrics elements declare (a burst's ``shots``); a declared
+    metric is also an attribute by its name when one element of the run declares it (``result.shots``).
+
     Window: the histories cover ``[0, end_time]`` s.  ``requested_end_time`` is what was asked for;
     ``end_time`` is smaller only when ``simulate(..., stop_when_final=...)`` stopped the solve because
     the named metrics were proven final (``stop_reason == "metrics_final"``, see
@@ -127,7 +133,8 @@ class Result:
     kinetic_energy_histories: dict[str, np.ndarray] = field(repr=False, default_factory=dict)
     element_of: dict[str, str] = field(repr=False, default_factory=dict)
     work_histories: dict[str, np.ndarray] = field(repr=False, default_factory=dict)
-    shots: list[dict[str, Any]] | None = None
+    element_histories: dict[str, dict[str, np.ndarray]] = field(repr=False, default_factory=dict)
+    element_metrics: dict[str, dict[str, Any]] = field(default_factory=dict)
     wall_time: float = 0.0
     timings: dict[str, float] = field(default_factory=dict)
     steps: int = 0
@@ -136,6 +143,16 @@ class Result:
     final_metrics: tuple[str, ...] = ALL_METRICS
     rest_time: float | None = None
     rest_tolerance: float | None = None
+
+    def __getattr__(self, name: str):
+        """A metric an element declares, by its name (``result.shots`` of a burst): the run's one element that
+        declares it (None if none of the run's does but a registered element could; see
+        :func:`~mbs_models.results.element_outputs.lookup`)."""
+        if name.startswith("_") or "element_metrics" not in self.__dict__:  # (copy, pickle: before the fields)
+            raise AttributeError(name)
+        from .element_outputs import lookup
+
+        return lookup(self, name)
 
     def __post_init__(self):
         # (while it is built: frozen from then on)
@@ -158,13 +175,15 @@ class Result:
         return self.accelerations[BARREL]
 
     def _single_absorber(self) -> str | None:
-        names = [name for name in self.positions if name != BARREL]
+        names = self.absorber_names
         return names[0] if len(names) == 1 else None
 
     @property
     def absorber_names(self) -> list[str]:
-        """The absorbers' (bodies') names."""
-        return [name for name in self.positions if name != BARREL]
+        """The absorbers' (bodies') names: the bodies of the elements whose role is an absorber
+        (:data:`~mbs_models.elements.declaration.ABSORBER`)."""
+        absorbers = set(elements_with(self.scene, ABSORBER))
+        return [name for name in self.positions if self.element_of.get(name, name) in absorbers]
 
     @property
     def absorber_position(self) -> np.ndarray | None:
@@ -259,10 +278,13 @@ class Result:
         return out
 
     def stops(self) -> list[dict[str, Any]]:
-        """Per end stop: ``name``, ``peak_contact_force`` (N) and time, ``impacts``, ``dissipated_energy`` (J)."""
+        """Per end stop (a contact of an element whose role is
+        :data:`~mbs_models.elements.declaration.END_STOP`): ``name``, ``peak_contact_force`` (N) and time,
+        ``impacts``, ``dissipated_energy`` (J)."""
         out = []
+        stops = set(elements_with(self.scene, END_STOP))
         for contact in self.contacts.values():
-            if contact.element in self.absorber_names:
+            if contact.element not in stops:
                 continue
             entry = contact.to_dict()
             entry["dissipated_energy"] = self.dissipated_energy.get(contact.name)
@@ -326,15 +348,15 @@ class Result:
         }
 
     def _firing_metrics(self) -> dict[str, Any]:
-        """``pulse_impulse`` (N s, with a breech-force pulse), ``shots`` (with a burst), ``work`` (J, with
-        external inputs): only for scenes that have them (version-1 keys stay as they were)."""
+        """``pulse_impulse`` (N s, with a breech-force pulse), the declared metrics
+        (:func:`~mbs_models.results.element_outputs.json_entries`: a burst's ``shots``), ``work`` (J, with external
+        inputs): only for scenes that have them (version-1 keys stay as they were)."""
         out: dict[str, Any] = {}
         firing = getattr(self.scene, "firing", None)
         pulse = getattr(firing, "pulse", None)
         if pulse is not None:
             out["pulse_impulse"] = firing.shot_momentum
-        if self.shots is not None:
-            out["shots"] = [dict(shot) for shot in self.shots]
+        out.update(element_outputs.json_entries(self))
         if self.work_histories:
             out["work"] = {name: float(history[-1]) for name, history in self.work_histories.items()}
         return out
@@ -379,7 +401,7 @@ class Result:
                          f"{self.time_of_peak_support_force:.5f} s{end_note('peak_support_force')}")
         else:
             lines.append(f"  peak support force       {not_final}")
-        if self.scene.has_absorber:
+        if elements_with(self.scene, ABSORBER):
             if self.peak_contact_force is None:
                 lines.append(f"  peak contact force       {not_final}")
             elif self.time_of_peak_contact_force is None:
@@ -402,14 +424,7 @@ class Result:
         firing = self._firing_metrics()
         if "pulse_impulse" in firing:
             lines.append(f"  breech pulse impulse     {firing['pulse_impulse']:.1f} N s per shot")
-        for shot in firing.get("shots", []):
-            back = "never back in battery" if shot["time_to_battery"] is None else \
-                f"in battery {shot['time_to_battery']:.3f} s after it"
-            state = "" if shot["in_battery_at_next_shot"] is None else \
-                (", in battery at the next shot" if shot["in_battery_at_next_shot"] else
-                 f", OUT of battery at the next shot (x = {shot['position_at_next_shot'] * 1e3:.1f} mm)")
-            lines.append(f"  shot {shot['shot']:<3d} at {shot['time']:7.3f} s  max {shot['max_barrel_displacement']:.6f} m, "
-                         f"{back}{state}")
+        lines += element_outputs.summary_lines(self)
         supplied = self.kinetic_energy_history[0] + self.stored_energy_history[0] + sum(firing.get("work", {}).values())
         lines.append(f"  energy dissipated        {self.total_dissipated_energy:.2f} J of "
                      f"{supplied:.2f} J" + (" (with the work of the inputs)" if "work" in firing else ""))

@@ -28,6 +28,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ..errors import SceneError
+from . import element_outputs
 from .plotting import new_figure
 
 #: Columns of a sweep table that are neither parameters nor plottable metrics.
@@ -69,8 +70,9 @@ TRADEOFF_METRICS = ("max_barrel_displacement", "peak_support_force")
 
 
 def metric_label(column: str) -> tuple[str, float]:
-    """Axis label (with unit) and the factor from SI for a metric column."""
-    return METRIC_UNITS.get(column, (f"{column.replace('_', ' ')} [SI]", 1.0))
+    """Axis label (with unit) and the factor from SI for a metric column (a declared metric in its declared unit)."""
+    unit = element_outputs.declared_column_unit(column) or "SI"
+    return METRIC_UNITS.get(column, (f"{column.replace('_', ' ')} [{unit}]", 1.0))
 
 
 def parameter_label(column: str) -> tuple[str, float]:
@@ -101,12 +103,14 @@ def read_sweep_table(path: str | Path, key: str = "FILE"):
 
 def is_metric_column(column: str) -> bool:
     """A metric or bookkeeping column of a sweep row (:mod:`mbs_models.studies.point`): a scalar metric,
-    a per-absorber or per-stop metric (``absorber.0.impacts``, ``<stop>.dissipated_energy``), the
+    a per-absorber or per-stop metric (``absorber.0.impacts``, ``<stop>.dissipated_energy``), a metric an
+    element declares (``progressive_spring.peak_force``), the
     run information or the status columns."""
     from ..studies.point import ABSORBER_METRICS, RUN_COLUMNS, SCALAR_METRICS, STATUS_COLUMNS, STOP_METRICS
 
     known = {*SCALAR_METRICS, *ABSORBER_METRICS, *STOP_METRICS, *RUN_COLUMNS, *STATUS_COLUMNS, *BOOKKEEPING_COLUMNS}
-    return column in known or column.rsplit(".", 1)[-1] in known
+    return (column in known or column.rsplit(".", 1)[-1] in known
+            or element_outputs.declared_column_unit(column) is not None)  # a metric an element declares
 
 
 def parameter_columns(table) -> list[str]:

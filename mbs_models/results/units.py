@@ -24,7 +24,13 @@ UNRULED_PARAMETER_UNITS = {"orifice_area": "m^2", "counter_recoil_orifice_area":
 
 def metric_si_unit(column: str) -> str:
     """The SI unit of a metric column (``max_barrel_displacement`` -> ``m``, ``time_of_...`` -> ``s``,
-    ``absorber.0.peak_contact_force`` -> ``N``); ``SI`` for a column not listed."""
+    ``absorber.0.peak_contact_force`` -> ``N``, a declared metric's declared unit); ``SI`` for a column not
+    listed."""
+    from .element_outputs import declared_column_unit
+
+    declared = declared_column_unit(column)
+    if declared is not None:
+        return declared
     name = column.rsplit(".", 1)[-1]
     if name.startswith("time_of_"):
         return "s"

@@ -3,7 +3,7 @@
 :func:`simulate_scene` is the one place where a sweep calls :func:`~mbs_models.simulate` (the scene-list
 sweeps of :mod:`.sweep` and the grid sweeps both go through it).  :func:`evaluate_point` applies the
 overrides (:func:`~mbs_models.scene.overrides.apply_overrides`), simulates and returns the row: the
-parameters, every scalar metric (:func:`metric_columns`), ``wall_time`` (s), ``status`` (``"ok"`` or the
+parameters, every scalar metric (:func:`metric_columns`, with those the elements declare), ``wall_time`` (s), ``status`` (``"ok"`` or the
 error's class) and ``error`` (its message on one line, None when ok).  Whatever goes wrong at a point is
 recorded in its row, and the sweep goes on: a :class:`~mbs_models.errors.SceneError` (an invalid
 combination of values), a :class:`~mbs_models.errors.SimulationError` (a failed solve) and any other
@@ -28,7 +28,9 @@ import time
 from dataclasses import dataclass
 from typing import Any, Mapping, Sequence
 
+from ..elements.declaration import ABSORBER, END_STOP, elements_with
 from ..engine.accuracy import SolverSettings
+from ..results import element_outputs
 from ..scene import Scene
 from ..scene.overrides import apply_overrides
 
@@ -40,9 +42,9 @@ SCALAR_METRICS = (
     "max_absorber_velocity", "time_of_max_absorber_velocity",
     "impacts",
 )
-#: Per absorber (scenes with several), as ``absorber.N.<metric>``.
+#: Per absorber (scenes with several elements whose role is an absorber), as ``absorber.N.<metric>``.
 ABSORBER_METRICS = ("peak_contact_force", "max_absorber_velocity", "impacts")
-#: Per end stop (a contact with the ground that is no absorber), as ``<element name>.<metric>``.
+#: Per end stop (an element whose role is an end stop), as ``<element name>.<metric>``.
 STOP_METRICS = ("peak_contact_force", "impacts", "dissipated_energy")
 #: Run information after the metrics: the barrel's initial velocity (m/s), the simulated end time (s, less
 #: than asked with an early stop), why the run ended, the solver's steps.
@@ -86,20 +88,19 @@ def simulate_scene(scene: Scene, settings: PointSettings):
 
 
 def _stops(scene: Scene) -> list[str]:
-    """Element names of the scene's end stops (contacts with the ground that are no absorbers)."""
-    from ..elements.absorber import Absorber
-    from ..elements.contact_laws import LawFields
-
-    return [name for name, table in scene.elements()
-            if isinstance(table, LawFields) and not isinstance(table, Absorber)]
+    """Element names of the scene's end stops (the elements whose role is
+    :data:`~mbs_models.elements.declaration.END_STOP`)."""
+    return elements_with(scene, END_STOP)
 
 
 def metric_columns(scene: Scene) -> list[str]:
     """The metric columns of a sweep over ``scene`` (its overrides change values, never the elements)."""
     columns = list(SCALAR_METRICS)
-    if len(scene.absorbers) > 1:
-        columns += [f"absorber.{i}.{m}" for i in range(len(scene.absorbers)) for m in ABSORBER_METRICS]
+    absorbers = elements_with(scene, ABSORBER)
+    if len(absorbers) > 1:
+        columns += [f"absorber.{i}.{m}" for i in range(len(absorbers)) for m in ABSORBER_METRICS]
     columns += [f"{stop}.{m}" for stop in _stops(scene) for m in STOP_METRICS]
+    columns += element_outputs.sweep_columns(scene)  # the metrics elements declare (``<element>.<name>``)
     return columns + list(RUN_COLUMNS)
 
 
@@ -107,7 +108,7 @@ def result_row(result, scene: Scene) -> dict[str, Any]:
     """The metric columns (:func:`metric_columns`) of one result."""
     row: dict[str, Any] = {name: getattr(result, name) for name in SCALAR_METRICS}
     row["impacts"] = None if result.impacts is None else len(result.impacts)
-    if len(scene.absorbers) > 1:
+    if len(elements_with(scene, ABSORBER)) > 1:
         for i, entry in enumerate(result.absorbers()):
             for metric in ABSORBER_METRICS:
                 value = entry[metric]
@@ -119,6 +120,7 @@ def result_row(result, scene: Scene) -> dict[str, Any]:
         impacts = entry.get("impacts")
         row[f"{stop}.impacts"] = None if impacts is None else len(impacts)
         row[f"{stop}.dissipated_energy"] = entry.get("dissipated_energy")
+    row.update(element_outputs.sweep_row(result))
     row.update(initial_velocity=scene.initial_velocity, end_time=result.end_time,
                stop_reason=str(result.stop_reason), steps=result.steps)  # the StopReason's text: tables hold strings
     return row

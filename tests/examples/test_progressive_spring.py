@@ -43,7 +43,12 @@ print(json.dumps({"stopped_early": stopped_early, "violations": violations(error
                   "connector": type(connector).__name__,
                   "overrides_nothing": [name for name in ("python_stored_energy", "stored_energy", "force_bound",
                                                           "tangent_stiffness") if name in type(connector).__dict__],
-                  "sweep_x": list(table["max_barrel_displacement"]), "sweep_status": list(table["status"])}))
+                  "sweep_x": list(table["max_barrel_displacement"]), "sweep_status": list(table["status"]),
+                  "peak_force": result.element_metrics["progressive_spring"]["peak_force"],
+                  "peak_force_attribute": result.peak_force,
+                  "force_history": result.element_histories["progressive_spring"]["force"].tolist(),
+                  "barrel_position": result.barrel_position.tolist(),
+                  "sweep_peak_force": list(table["progressive_spring.peak_force"])}))
 """
 
 
@@ -103,10 +108,43 @@ def test_a_sweep_over_the_new_tables_key(python_run):
     assert python_run["sweep_x"][1] == pytest.approx(python_run["x"], rel=1e-12)
 
 
-def test_recoil_run_and_validate_with_the_plugin(python_run):
-    run = json.loads(_run(["-m", "mbs_models", "--plugin", str(EXAMPLE), "run", str(SCENE), "--json"]))
+K1, K3 = 20000.0, 2.0e6  # N/m, N/m^3: examples/progressive_spring.toml
+
+
+def test_the_declared_force_history_and_its_peak_are_in_the_result(python_run):
+    """The declared history is the law on the barrel's position, ``F = k1 x + k3 x^3`` (computed here from the
+    positions); the declared peak is its largest magnitude.  F increases with x, so the peak is F at the largest
+    sampled x, which lies at or below the refined maximum displacement and within 0.1 % of it in force (an output
+    step of the standard accuracy moves x by far less near the turning point, where v ~ 0)."""
+    import numpy as np
+
+    x = np.array(python_run["barrel_position"])
+    force = np.array(python_run["force_history"])
+    assert force == pytest.approx(K1 * x + K3 * x ** 3, rel=1e-12, abs=1e-9)
+    peak = python_run["peak_force"]
+    assert peak == pytest.approx(float(np.max(np.abs(K1 * x + K3 * x ** 3))), rel=1e-12)
+    at_max = K1 * python_run["x"] + K3 * python_run["x"] ** 3
+    assert at_max * (1.0 - 1e-3) <= peak <= at_max * (1.0 + 1e-12)
+    assert python_run["peak_force_attribute"] == peak  # the declared metric by its name on the Result
+
+
+def test_the_declared_peak_is_a_sweep_column(python_run):
+    """k3 = 0: the linear spring, F = k1 x at its larger travel; the second point is the scene as run."""
+    assert python_run["sweep_peak_force"][1] == pytest.approx(python_run["peak_force"], rel=1e-12)
+    assert python_run["sweep_peak_force"][0] == pytest.approx(K1 * python_run["sweep_x"][0], rel=1e-3)
+
+
+def test_recoil_run_and_validate_with_the_plugin(python_run, tmp_path):
+    csv_path = tmp_path / "histories.csv"
+    run = json.loads(_run(["-m", "mbs_models", "--plugin", str(EXAMPLE), "run", str(SCENE), "--json",
+                           "--csv", str(csv_path)]))
     assert run["max_barrel_displacement"] == pytest.approx(python_run["x"], rel=1e-12)
     assert run["peak_support_force"] == pytest.approx(python_run["S"], rel=1e-12)
+    assert run["progressive_spring"] == {"peak_force": pytest.approx(python_run["peak_force"], rel=1e-12)}
+    import pandas as pd
+
+    histories = pd.read_csv(csv_path)
+    assert list(histories["progressive_spring force [N]"]) == pytest.approx(python_run["force_history"], rel=1e-12)
     validate = json.loads(_run(["-m", "mbs_models", "--plugin", str(EXAMPLE), "validate", str(SCENE), "--json"]))
     assert validate["passed"] is True
 

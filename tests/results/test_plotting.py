@@ -52,3 +52,24 @@ def test_the_run_plot_zooms_on_the_first_impact():
 def test_without_impacts_there_is_no_zoom():
     axes = plot_result(simulate(simplified_model(), 1.0, "draft")).axes
     assert len(axes) == 3 and axes[-1].get_xlabel() == "time [s]"
+
+
+def test_a_declared_history_with_a_panel_gets_one_after_the_velocities(monkeypatch):
+    """The recoil spring given (for this test) a declared force history F = k x_M on a panel in kN: a fourth panel
+    after the velocities, holding k x_M / 1000, with the time axis label moved to it."""
+    import numpy as np
+
+    from mbs_models.elements.declaration import History, Outputs
+    from mbs_models.elements.recoil_spring import RecoilSpring
+
+    monkeypatch.setattr(RecoilSpring, "OUTPUTS", Outputs(histories=(
+        History("force", "N", lambda run: run.force(), panel="spring force [kN]", scale=1e-3),)))
+    scene = simplified_model()
+    result = simulate(scene, 1.0, "draft")
+    axes = plot_result(result).axes
+    assert len(axes) == 4 and axes[2].get_ylabel() == "velocity [m/s]" and axes[3].get_ylabel() == "spring force [kN]"
+    (line,) = axes[3].get_lines()
+    assert line.get_label() == "recoil spring force"
+    expected = scene.recoil_spring.stiffness * result.barrel_position / 1e3
+    assert np.asarray(line.get_ydata()) == pytest.approx(expected, rel=1e-12, abs=1e-12)
+    assert axes[3].get_xlabel() == "time [s]" and axes[2].get_xlabel() == ""
