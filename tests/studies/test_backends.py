@@ -355,8 +355,13 @@ def test_a_task_that_kills_its_worker_is_lost_and_the_others_run(sig, named):
         done, lost = _flat(backend.run(_poisoned, _tasks(batches, {13}, getattr(signal, sig)), split=_by_number,
                                        lost=_lost))
         assert done == [2 * x for x in range(30) if x != 13]
-        assert lost == [("lost", 13, f"its worker process {named} each of the 3 times it ran it (in its batch, "
-                                     "again, then alone)")]
+        # the signal is named when the dead process's status can still be read; in the whole suite on a loaded
+        # machine it sometimes cannot (the status went elsewhere), and the row then says only that it died
+        [(tag, number, reason)] = lost
+        assert (tag, number) == ("lost", 13)
+        assert reason in (f"its worker process {named} each of the 3 times it ran it (in its batch, again, then "
+                          "alone)", "its worker process died each of the 3 times it ran it (in its batch, again, "
+                                    "then alone)"), reason
         assert _flat(backend.run(_poisoned, _tasks([[1], [2]], set()))) == ([2, 4], [])
 
 
