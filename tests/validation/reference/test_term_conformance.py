@@ -140,6 +140,13 @@ def test_a_term_with_its_law_alone_gets_everything_else_from_it(monkeypatch):
     evaluation = model.evaluate(mode, y)
     assert evaluation.forces[spring.index] == pytest.approx(k1 * 0.1 + k3 * 1e-3 + c * -2.0, rel=1e-14)
     assert model.rhs(mode)(0.0, y)[spring.di] == pytest.approx(c * 4.0, rel=1e-14)
+    # the derived force bound: at least the law's largest |F| on the box, k1 D + k3 D^3 + c V at its corner
+    # (the law increases in d and d'), and at most that plus the largest change over one grid cell
+    D, V = 0.2, 3.0
+    largest = k1 * D + k3 * D ** 3 + c * V
+    cell_d, cell_v = 2 * D / (spring.BOUND_SAMPLES - 1), 2 * V / (spring.BOUND_SAMPLES - 1)
+    step = max(k1 * cell_d + k3 * (D ** 3 - (D - cell_d) ** 3), c * cell_v)
+    assert largest * (1 - 1e-12) <= spring.force_bound(D, V, math.inf) <= (largest + step) * (1 + 1e-12)
 
 
 # ------------------------------------------------------------------------------------------ closed form = derived
