@@ -77,32 +77,22 @@ register_element(ProgressiveSpring)
 
 # ---------------------------------------------------------------------------------------------- the reference's side
 class ReferenceProgressiveSpring(reference.Connector):
-    """The reference's progressive spring: ``F = k1 d + k3 d^3``, ``U = k1 d^2 / 2 + k3 d^4 / 4``,
-    ``dF/dt = (k1 + 3 k3 d^2) d'``, ``|F| <= k1 D + k3 D^3`` for ``|d| <= D`` (F is odd and increasing)."""
+    """The reference's progressive spring, given by its law ``F = k1 d + k3 d^3`` (and ``dF/dt = (k1 + 3 k3 d^2)
+    d'``): the stored energy ``k1 d^2 / 2 + k3 d^4 / 4``, the force at rest and the force bound of the early stop
+    are derived from the law by :class:`validation.reference.model.Connector`."""
 
-    stores_energy = True
+    dissipates = False
     nonlinear_potential = True  # not k d^2 / 2: the reference's early stop bounds it with the barrel's stops
 
     def __init__(self, name: str, a: str, b: str, k1: float, k3: float):
         super().__init__(name, a, b)
         self.k1, self.k3 = float(k1), float(k3)
 
-    def equations(self, state) -> reference.Equations:
-        return reference.Equations("""
-            d = {xb} - {xa}
-            {F} = {k1} * d + {k3} * d * d * d""", dict(k1=self.k1, k3=self.k3))
+    def law(self, d, rate, state=None):
+        return self.k1 * d + self.k3 * d * d * d
 
     def force_rate(self, state, d, rate, acceleration):
         return (self.k1 + 3.0 * self.k3 * d * d) * rate
-
-    def stored_energy(self, d):
-        return 0.5 * self.k1 * d ** 2 + 0.25 * self.k3 * d ** 4
-
-    def static_force(self, d: float) -> float:
-        return self.k1 * d + self.k3 * d ** 3
-
-    def force_bound(self, d_bound: float, rate_bound: float, penetration_bound: float) -> float:
-        return self.k1 * d_bound + self.k3 * d_bound ** 3
 
 
 class ReferenceTerm:

@@ -42,8 +42,8 @@ _LAZY = {
     "assemble": ".engine.assembly",
     "Assembly": ".engine.assembly",
     "Mechanism": ".engine.mechanism",
-    "FINAL_METRICS": ".engine.final_metrics",   # names accepted by simulate(..., stop_when_final=...)
-    "EnergyBounds": ".engine.final_metrics",
+    "FINAL_METRICS": ".engine.finality",   # names accepted by simulate(..., stop_when_final=...)
+    "EnergyBounds": ".engine.energy_bounds",
     "contacts_out_of_reach": ".engine.reach",  # gaps and stops beyond the barrel's free-recoil travel
     "add_contact": ".elements.contact_laws",
     "add_recoil_damper": ".elements.recoil_damper",

@@ -355,10 +355,10 @@ def reference_modes(model) -> list:
     for c in model.connectors:
         if c.is_contact:
             choices = [ContactMode("off"), ContactMode("off", True, True, 0.0, 0.3),
-                       ContactMode("on", True, False, c.law.episode_factor(0.3), 0.3),
-                       ContactMode("on", True, False, c.law.episode_factor(0.0), 0.0)]
+                       ContactMode("on", True, False, c.contact_law.episode_factor(0.3), 0.3),
+                       ContactMode("on", True, False, c.contact_law.episode_factor(0.0), 0.0)]
             if c.compression_only:
-                choices.append(ContactMode("stick", True, False, c.law.damping_factor, 0.3))
+                choices.append(ContactMode("stick", True, False, c.contact_law.damping_factor, 0.3))
             options.append(choices)
         elif c.classify_pass == 2:
             options.append([True, False])

@@ -114,7 +114,7 @@ class Connector(abc.ABC):
     monotone = False
     #: True when the stored energy is the quadratic form ``quadratic_stiffness d^2 / 2`` (or none): the energy
     #: bounds of the early stop then use it as such.  False (the default) for any other potential, which the
-    #: bounds take as a function (:class:`~mbs_models.engine.final_metrics.PotentialWell`).
+    #: bounds take as a function (:class:`~mbs_models.engine.energy_bounds.PotentialWell`).
     quadratic_potential = False
     #: False only for a law whose conservative part ``F(d, 0)`` vanishes everywhere (a pure damper, friction).
     stores_energy = True

@@ -26,7 +26,7 @@ for small d).  U is increasing and convex, negative for d < 0 (the gas expands b
 without bound as ``d -> V0/A``: the gas spring cannot be bottomed out by any finite energy.  It stores and
 never dissipates energy.  Its tangent stiffness is ``dF/dd = n p0 A^2 / V0 r^(n+1)``.
 
-**Bounds** (the early stop, :mod:`mbs_models.engine.final_metrics`): the potential is not the quadratic
+**Bounds** (the early stop, :mod:`mbs_models.engine.energy_bounds`): the potential is not the quadratic
 form ``k d^2 / 2`` of a linear spring and not >= 0 (:attr:`RecuperatorConnector.quadratic_potential` is
 False); the early stop bounds the barrel from the potential well this connector forms with the stops
 (see there).  The force bound is ``F(d_max)`` (F is positive and increasing).  The *linear stiffness*

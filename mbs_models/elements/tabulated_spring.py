@@ -27,7 +27,7 @@ and an absorber would leave the early stop without its potential well: not suppo
 
 **Bounds**: ``|F| <= max |F|`` over ``|x| <= x_max`` (at the ends or a point inside; F is monotone); the early
 stop bounds x from the potential well this spring forms with the barrel's stops
-(:mod:`mbs_models.engine.final_metrics`: ``quadratic_potential`` is False).  The stability checks linearise it
+(:mod:`mbs_models.engine.energy_bounds`: ``quadratic_potential`` is False).  The stability checks linearise it
 with its steepest segment.  A table reaching beyond 5 m (:data:`MAX_STROKE`) gets a UnitWarning naming the key
 (displacements in mm?).
 """

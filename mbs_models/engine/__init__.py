@@ -7,7 +7,8 @@
 * :mod:`.stability` -- contact time scales, unsafe steps refused, stepped-over contacts, energy balance;
 * :mod:`.guard` -- the step budget and the cap on stored samples of adaptive solves;
 * :mod:`.time_scales` -- springs and dampers too stiff for the budget, refused before the solve;
-* :mod:`.final_metrics` -- the early stop once energy bounds prove the peak metrics final;
+* :mod:`.energy_bounds` -- energy bounds on what a dissipative scene can still do; :mod:`.finality` -- the early
+  stop once they prove the peak metrics final (:mod:`.final_metrics` re-exports both);
 * :mod:`.reach` -- contacts that can never close (a gap beyond the barrel's free-recoil travel).
 
 This package imports Exudyn.

@@ -28,7 +28,7 @@ from ..scene import Scene
 from . import stability
 from .accuracy import MIN_RELATIVE_TOLERANCE, SolverSettings
 from .assembly import Assembly, assemble
-from .final_metrics import FinalityTracker
+from .finality import FinalityTracker
 from .guard import StepBudget, sample_cap
 from .mechanism import Mechanism
 from .readout import collect, read_segment

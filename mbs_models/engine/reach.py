@@ -19,7 +19,7 @@ the smaller is used (:func:`contact_reach_bounds`):
   contact open, none ever closes.
 * **Energy** (whatever closes): the mechanical energy of the whole scene never exceeds its value at
   t = 0, so ``d <= sqrt(2 E0 g^T K^+ g)`` over all the springs (a potential well's end for a gas spring):
-  :meth:`EnergyBounds.contact_reach <mbs_models.engine.final_metrics.EnergyBounds.contact_reach>`, the
+  :meth:`EnergyBounds.contact_reach <mbs_models.engine.energy_bounds.EnergyBounds.contact_reach>`, the
   bound the early stop uses.  A contact beyond it never closes, whatever the others do.
 
 Both use the early stop's ``ENERGY_SLACK`` on the energies.  A contact reported here therefore truly never
@@ -39,7 +39,7 @@ import numpy as np
 
 from ..elements.connector import GROUND
 from ..scene import Scene
-from .final_metrics import ENERGY_SLACK, EnergyBounds, dissipative
+from .energy_bounds import ENERGY_SLACK, EnergyBounds, dissipative
 from .mechanism import Mechanism
 
 

@@ -10,7 +10,7 @@ requested end time (``stop_reason == "at_rest"``; DESIGN.md, "Stop at rest").
 The rest state
 --------------
 Velocities 0; positions ``x*`` with ``K x* = 0`` (every linear spring at ``d = 0``; K is the quadratic form of
-:mod:`mbs_models.engine.final_metrics`) and, with a potential well on body b (a recuperator against its
+:mod:`mbs_models.engine.energy_bounds`) and, with a potential well on body b (a recuperator against its
 battery stop), ``x*_b = x_r``, the well's computed minimum; every contact outside the well open there
 (``p <= 0``).  Without a well ``x* = 0``.  With a well, ``x* = x_r P e_b / |P e_b|^2`` (P: the projection on
 K's null space): bodies tied to b by springs rest where b does.
@@ -18,7 +18,7 @@ K's null space): bodies tied to b by springs rest where b does.
 The proof
 ---------
 After the last input the mechanical energy E of a dissipative scene never increases
-(:mod:`mbs_models.engine.final_metrics`).  Split ``E = N + W(x_b)``: N (J) sums the kinetic energies, the
+(:mod:`mbs_models.engine.energy_bounds`).  Split ``E = N + W(x_b)``: N (J) sums the kinetic energies, the
 springs' ``k d^2 / 2`` and the contacts' elastic energies outside the well, every term >= 0; W is the well's
 convex potential (W = 0 without one).  ``Q = E - W(x_r) = N + G(x_b)`` with ``G = W - W(x_r)`` never
 increases either, so for every ``t >= t_r``, with ``gamma = W(x_r) - min W >= 0`` (``x_r`` is the minimum
@@ -41,7 +41,7 @@ computed state at ``t_r``: it needs no assumption on the integration error befor
 solver's.  Since ``x*`` is within ``tolerance`` of the solution at every later time, the held state is.
 
 No rest stop (the solve runs to its end time) where none can be proven: a scene that injects energy or has a
-load that never ends (:func:`~mbs_models.engine.final_metrics.dissipative` is False); a connector that
+load that never ends (:func:`~mbs_models.engine.energy_bounds.dissipative` is False); a connector that
 :attr:`~mbs_models.elements.connector.Connector.sticks` (Coulomb friction: no single rest position); a body
 no spring holds (a free absorber); a well whose body is held by a linear spring too (its rest is not the
 well's minimum, so ``E - W(x_r)`` never falls below the threshold); a contact closed at ``x*`` outside the
@@ -67,7 +67,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..results.samples import Samples
-from .final_metrics import ENERGY_SLACK, EnergyBounds, _QuadraticForm, connector_ends, dissipative
+from .energy_bounds import ENERGY_SLACK, EnergyBounds, _QuadraticForm, connector_ends, dissipative
 from .mechanism import Mechanism
 
 #: Simulated time (s) of a chunk between rest checks; runs no longer than this are never stopped at rest.

@@ -5,7 +5,7 @@
   :data:`MAX_SEGMENTS` segments or an adaptive one whose time scales need more steps than its budget
   (:mod:`mbs_models.engine.guard`) is refused before solving (SceneError naming the key).
 * :class:`RunPolicy`: the settings, the end time, the metrics to prove final (``stop_when_final``; an early stop
-  only where energy bounds exist, :func:`~mbs_models.engine.final_metrics.dissipative`) and the rest watch's
+  only where energy bounds exist, :func:`~mbs_models.engine.energy_bounds.dissipative`) and the rest watch's
   tolerance (``stop_at_rest``, adaptive solvers only).
 * :func:`conclude`: once the driver solved, why the run ended (:class:`~mbs_models.stop_reason.StopReason`),
   which metrics are final, the histories (the rest state held to the end time) -- a
@@ -25,7 +25,8 @@ from ..scene import Scene
 from ..stop_reason import StopReason
 from . import stability
 from .accuracy import SolverSettings, solver_settings_for
-from .final_metrics import ENERGY_SLACK, FINAL_METRICS, FinalityTracker, check_metric_names, dissipative, largest_energy_rise
+from .energy_bounds import ENERGY_SLACK, dissipative, largest_energy_rise
+from .finality import FINAL_METRICS, FinalityTracker, check_metric_names
 from .guard import StepBudget
 from .mechanism import Mechanism
 from .rest import CHECK_INTERVAL, RestWatch
@@ -154,7 +155,7 @@ def conclude(policy: RunPolicy, solve: "Solve", scene: Scene, started: float, wa
 
 def early_stop_trusted(result: Result, solve: "Solve") -> bool:
     """True unless ``result`` stopped once its metrics were final while its mechanical energy (less the work of
-    the inputs, above the bounds' energy floor) rose by more than :data:`~mbs_models.engine.final_metrics.ENERGY_SLACK`
+    the inputs, above the bounds' energy floor) rose by more than :data:`~mbs_models.engine.energy_bounds.ENERGY_SLACK`
     somewhere: the bounds assume it never rises, so such an early stop is not trusted."""
     if result.stop_reason is not StopReason.METRICS_FINAL:
         return True

@@ -9,7 +9,7 @@ Contract
   :class:`~mbs_models.errors.SimulationError` is raised: a solver that fails, stops before
   ``end_time``, or produces NaN/inf never yields a result.  The one exception is asked for:
   ``stop_when_final`` stops the solve once energy bounds prove the named metrics final
-  (:mod:`mbs_models.engine.final_metrics`); the result says so (``stop_reason``, ``requested_end_time``)
+  (:mod:`mbs_models.engine.finality`); the result says so (``stop_reason``, ``requested_end_time``)
   and holds None for every metric not proven final.  A run longer than 100 s that energy bounds prove at
   rest stops there too (:mod:`mbs_models.engine.rest`); its result still covers ``[0, end_time]``, holding
   the rest state from ``rest_time`` on (``stop_reason == "at_rest"``).  Bad arguments raise
@@ -65,10 +65,10 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
     impact_threshold: a contact episode counts as an impact when its peak force rises above the force the
         contact held at rest when it began (0, or at t = 0 an initial interference's ``k p^n``) by more than
         this (N).
-    stop_when_final: metric names among :data:`~mbs_models.engine.final_metrics.FINAL_METRICS`
+    stop_when_final: metric names among :data:`~mbs_models.engine.finality.FINAL_METRICS`
         (``"max_barrel_displacement"``, ``"peak_contact_force"``, ``"max_absorber_velocity"``,
         ``"impacts"``).  The solve stops as soon as energy bounds prove that none of them can change
-        before ``end_time`` (:mod:`mbs_models.engine.final_metrics`); the result then covers
+        before ``end_time`` (:mod:`mbs_models.engine.finality`); the result then covers
         ``[0, result.end_time]`` with ``result.requested_end_time`` = ``end_time``,
         ``result.stop_reason == "metrics_final"``, and every metric *not* proven final at the stop
         (with its time) is None (``impacts`` too), never a value of the shorter window.  Scenes that

@@ -18,7 +18,7 @@ import conformance
 from mbs_models import load_scene
 from mbs_models.elements import ELEMENT_TABLES, GROUND, Connector, LinearSpringDamper
 from mbs_models.elements.contact_laws import CONTACT_LAWS
-from mbs_models.engine.final_metrics import dissipative
+from mbs_models.engine.energy_bounds import dissipative
 from mbs_models.engine.mechanism import Mechanism
 
 SCENE_FILES = sorted((Path(__file__).parents[2] / "mbs_models" / "scenes").glob("*.toml"))

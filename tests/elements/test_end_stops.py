@@ -366,7 +366,7 @@ def test_a_recoil_stop_out_of_reach_names_its_position():
     with the undamped free recoil's sqrt(2 E0 / k) as the barrel's reach."""
     import math
 
-    from mbs_models.engine.final_metrics import ENERGY_SLACK
+    from mbs_models.engine.energy_bounds import ENERGY_SLACK
     from mbs_models.engine.reach import contacts_out_of_reach
 
     scene = load_scene(scene_path("end_stops")).with_changes(**{"recoil_stop.position": 120.0})

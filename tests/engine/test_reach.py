@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from mbs_models import load_scene, model_i, model_ii, simplified_model, simulate
-from mbs_models.engine.final_metrics import ENERGY_SLACK, EnergyBounds
+from mbs_models.engine.energy_bounds import ENERGY_SLACK, EnergyBounds
 from mbs_models.engine.mechanism import Mechanism
 from mbs_models.engine.reach import contact_reach_bounds, contacts_out_of_reach
 from mbs_models.scenes import list_scenes, scene_path

@@ -21,7 +21,7 @@ from mbs_models import (Burst, Conventions, RecoilSpring, SceneError, SolverSett
                         simplified_model, simulate)
 from mbs_models.engine import final_metrics as fm
 from mbs_models.engine.accuracy import ACCURACY_PRESETS
-from mbs_models.engine.final_metrics import EnergyBounds
+from mbs_models.engine.energy_bounds import EnergyBounds
 from mbs_models.engine.mechanism import Mechanism
 from mbs_models.engine.reuse import Simulator
 from mbs_models.engine.rest import CHECK_INTERVAL, RIEMANN_PIECES, RestState, RestWatch, well_energy

@@ -15,7 +15,8 @@ Kinds: ``"rhs"`` (Python floats; ``dy/dt``, inf where the arithmetic overflows, 
 ``"scalar"`` and ``"array"`` (one state on Python floats, or numpy rows: the raw forces, the
 accelerations and the support force ``fg`` = S; ``omit`` leaves one connector out).  The same source
 serves all three: only ``copysign`` differs (``math`` or ``numpy``).  Constants are written with
-``repr`` (exact).  ``source(...)`` shows the code of a mode.
+``repr`` (exact); a callable constant (a connector's law, :meth:`Connector.equations`'s default) is called by
+name.  ``source(...)`` shows the code of a mode.
 
 A model with external loads (:class:`~validation.reference.model.Load`) adds, before the connectors
 (a sliding contact's constraint force sees them), ``L_k = <the load's piece in the mode, from t>`` and
@@ -60,8 +61,10 @@ def _point(model, body) -> tuple[str, str, str]:
     return f"x{body}", f"v{body}", f"f{body}"
 
 
-def source(model, mode, kind: str, omit: int | None = None) -> str:
-    """The Python source of ``kind`` (module docstring) for ``mode`` of ``model``."""
+def source(model, mode, kind: str, omit: int | None = None, functions: dict | None = None) -> str:
+    """The Python source of ``kind`` (module docstring) for ``mode`` of ``model``; the callable constants of the
+    equations (a law called as a function) are named ``<constant>_<j>`` and put into ``functions``."""
+    functions = {} if functions is None else functions
     nb = model.n_bodies
     names = [n for i in range(nb) for n in (f"x{i}", f"v{i}")] + ["_"] * (model.n_states - 2 * nb)
     unpack = "y" if kind == "array" else "y.tolist()"
@@ -85,7 +88,13 @@ def source(model, mode, kind: str, omit: int | None = None) -> str:
             continue
         xa, va, fa = _point(model, c.body_a)
         xb, vb, fb = _point(model, c.body_b)
-        fields = {k: repr(float(v)) for k, v in equations.constants.items()}
+        fields = {}
+        for k, v in equations.constants.items():
+            if callable(v):
+                fields[k] = f"{k}_{j}"
+                functions[fields[k]] = v
+            else:
+                fields[k] = repr(float(v))
         code = equations.code.format(xa=xa, xb=xb, va=va, vb=vb, fa=fa, fb=fb, F=f"F{j}", P=f"P{j}", **fields)
         lines = [f"# {c.name}: {state!r}"] + [line.strip() for line in code.strip().splitlines()]
         lines += [f"{fa} += F{j}", f"{fb} -= F{j}"]
@@ -113,6 +122,8 @@ def compile_mode(model, mode, kind: str, omit: int | None = None):
     """The function of ``kind`` for ``mode`` (see the module docstring)."""
     namespace = dict(_NAMESPACES[kind])
     namespace.update({f"load{k}": load.force for k, load in enumerate(model.loads)})
-    text = source(model, mode, kind, omit)
+    functions: dict = {}
+    text = source(model, mode, kind, omit, functions)
+    namespace.update(functions)
     exec(compile(text, f"<reference {kind} of {mode!r}>", "exec"), namespace)  # noqa: S102 - our own source
     return namespace["rhs" if kind == "rhs" else "evaluate"]

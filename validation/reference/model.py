@@ -43,10 +43,13 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
+import abc
 import bisect
+import functools
 import math
 
 import numpy as np
+from scipy.integrate import quad
 
 from .codegen import compile_mode
 
@@ -87,8 +90,9 @@ class Equations:
     ``code``: lines that set ``{F}`` (N) and, for a dissipating connector, ``{P}`` (W: ``F d' - dU/dt``)
     from ``{xa}``, ``{xb}``, ``{va}``, ``{vb}`` (positions, velocities of a and b; ``0.0`` for the ground)
     and, for a ``constraint`` (computed after all the others), the forces ``{fa}``, ``{fb}`` on a and b so
-    far.  Every other ``{name}`` is a number of ``constants``; temporaries are plain names; the functions
-    ``abs`` and ``copysign`` are available.
+    far.  Every other ``{name}`` is a number of ``constants``, or a function (a callable constant: the default
+    equations call the connector's law); temporaries are plain names; the functions ``abs`` and ``copysign`` are
+    available.
     """
 
     code: str
@@ -96,11 +100,45 @@ class Equations:
     constraint: bool = False
 
 
-class Connector:
-    """A force between points ``a`` and ``b`` (body names or :data:`GROUND`); see the module docstring.
+class Connector(abc.ABC):
+    """A force between points ``a`` and ``b`` (body names or :data:`GROUND`): the reference's side of the element
+    contract (DESIGN.md, "The element contract"), written from its equations.
 
-    Subclasses (in the term modules) give the law: :meth:`equations` per state, and what the solver, the
-    result and the early stop need.  Class attributes:
+    The force law ``F(d, d')`` (N) is the connector: :meth:`law`, the one mandatory part.  A term whose
+    connector has no law cannot be instantiated (TypeError while the reference model is built), never a silent
+    zero force.  Everything else is derived from the law unless the term gives it in closed form, which
+    ``tests/validation/reference/test_term_conformance.py`` checks against the derived one::
+
+        conservative part   F_c(d)   = F(d, 0)                     (static_force)
+        stored energy       U(d)     = integral_0^d F_c(s) ds      (stored_energy: scipy's quad on a float,
+                                                                    on arrays between the sorted samples,
+                                                                    summed outward from 0; piece by piece
+                                                                    between the kinks)
+        dissipated power    P(d, d') = (F(d, d') - F_c(d)) d'      (dissipated_power; = F d' - dU/dt)
+        force bound         B(D, V) >= max |F(d, d')| over |d| <= D, |d'| <= V   (force_bound)
+
+    To add a term (a connector with a law of its own)
+    --------------------------------------------------
+    1. Subclass :class:`Connector` and implement :meth:`law` ``(d, rate, state=None) -> F`` in N, on floats and
+       on numpy arrays; a contact's law is its physical force (clipped to >= 0).
+    2. Call ``super().__init__(name, a, b)``.
+    3. Declare what holds for the law (class or instance attributes; the defaults are the safe ones):
+       :attr:`stores_energy` (False only where ``F(d, 0) = 0`` for every d: a damper, friction),
+       :attr:`dissipates` (False only where ``F(d, d') = F(d, 0)``: a spring), :attr:`kinks` (the d where
+       ``F(d, 0)`` or its slope jumps), :attr:`d_limit`, :attr:`injects_energy`, :attr:`is_contact`,
+       :attr:`nonlinear_potential` (its potential is neither ``k d^2 / 2`` nor >= 0: the early stop bounds it
+       with its body's stops, :mod:`validation.reference.finality`).
+    4. Optionally give closed forms, each replacing a derived default and checked against it:
+       :meth:`stored_energy`, :meth:`static_force`, :meth:`force_bound`, :attr:`linear_stiffness` (the
+       stiffness of an always-acting linear spring: the energy bounds' quadratic form), :meth:`force_rate`
+       (dF/dt; None, the default, has the result find peaks numerically).
+    5. Optionally give :meth:`equations`, the law of one mode as Python source (the solver's speed; the
+       default calls :meth:`law`), and, for a law with discrete states (pieces, branches, contact phases),
+       :meth:`provisional`, :meth:`classify`, :meth:`events` and :attr:`classify_pass`.
+    6. Add the term module (``TABLES``, ``build``) to :mod:`validation.reference.terms`, or register it from
+       outside with :func:`validation.reference.terms.register_term`.
+
+    Class attributes (flags):
 
     * ``is_contact`` -- a contact (episodes, impacts, onsets are reported for it);
     * ``dissipates`` -- it has a dissipated-energy state (set per instance where it depends on values);
@@ -108,18 +146,18 @@ class Connector:
     * ``injects_energy`` -- its law can add energy (the early stop has no bound then);
     * ``classify_pass`` -- 0: no discrete state; 1: decided on the accelerations *without* its own force
       (contacts); 2: decided on the accelerations of the classified mode (velocity-sign switches);
-    * ``nonlinear_potential`` -- its potential is neither a linear spring's ``k d^2 / 2`` nor >= 0 (the
-      recuperator's gas spring): the early stop bounds it together with its body's stops
-      (:mod:`validation.reference.finality`); ``d_limit`` (m) is the largest d where its law is defined.
+    * ``nonlinear_potential`` -- see step 3; ``d_limit`` (m) is the largest d where its law is defined.
     """
 
     is_contact = False
-    dissipates = False
-    stores_energy = False
+    dissipates = True
+    stores_energy = True
     classify_pass = 0
     injects_energy = False
     nonlinear_potential = False
     d_limit = float("inf")
+    #: Samples per axis of the box in the derived force bound.
+    BOUND_SAMPLES = 41
 
     def __init__(self, name: str, a: str, b: str):
         if a == b:
@@ -162,27 +200,91 @@ class Connector:
         """``1/m_a + 1/m_b`` in 1/kg (the ground counts as infinitely heavy)."""
         return sum(1.0 / m for m in (self.mass_a, self.mass_b) if m is not None)
 
-    # ------------------------------------------------------------------ the law (overridden)
+    # ------------------------------------------------------------------ the law (mandatory)
+    @abc.abstractmethod
+    def law(self, d, rate, state=None):
+        """The force F (N) at relative coordinate ``d`` (m) and rate ``rate`` (m/s), floats or numpy arrays.
+
+        ``state`` is the connector's discrete state in a mode (what :meth:`classify` gives); it matters only
+        for a law with memory (a restitution contact's episode), None otherwise."""
+
     def equations(self, state) -> Equations | None:
-        """The force in ``state`` (:class:`Equations`); None: no force, no power."""
-        return None
+        """The force in ``state`` as source (:class:`Equations`): by default the law itself, called with
+        ``d = x_b - x_a``, ``d' = v_b - v_a`` and ``state``, and, for a connector that dissipates, the power
+        ``(F - F(d, 0)) d'``.  None: no force, no power."""
+        law = functools.partial(self.law, state=state)
+        if not self.dissipates:
+            return Equations("{F} = {law}({xb} - {xa}, {vb} - {va})", dict(law=law))
+        return Equations("""
+            d = {xb} - {xa}
+            rate = {vb} - {va}
+            {F} = {law}(d, rate)
+            {P} = ({F} - {law}(d, 0.0 * rate)) * rate""", dict(law=law))
 
     def reported(self, force):
         """The force as reported (N): the law's value; contacts clip it to >= 0."""
         return force
 
     def force_rate(self, state, d, rate, acceleration):
-        """dF/dt (N/s) in ``state`` from d (m), d' (m/s), d'' (m/s^2) (numpy); None if not analytic."""
-        return 0.0 * rate
+        """dF/dt (N/s) in ``state`` from d (m), d' (m/s), d'' (m/s^2) (numpy); None: not analytic (the
+        result then finds a peak of the force numerically)."""
+        return None
+
+    # ------------------------------------------------------------------ derived unless closed form
+    def static_force(self, d: float) -> float:
+        """``F_c(d) = F(d, 0)`` (N) at ``d`` (m, a float): the force at rest (the static equilibrium at t = 0, the
+        early stop's potential well)."""
+        return float(self.law(float(d), 0.0))
+
+    def dissipated_power(self, d, rate, state=None):
+        """``P = (F(d, d') - F(d, 0)) d'`` (W) on floats or arrays: the law's power not stored."""
+        return (self.law(d, rate, state) - self.law(d, 0.0 * rate, state)) * rate
+
+    @property
+    def kinks(self) -> tuple[float, ...]:
+        """The d (m) where ``F(d, 0)`` or its slope jumps: the derived stored energy integrates between them."""
+        return ()
 
     def stored_energy(self, d):
-        """Stored (potential) energy U(d) in J (numpy or float)."""
-        return 0.0 * d
+        """``U(d) = integral_0^d F(s, 0) ds`` (J) on a float or an array (0 for a connector that stores none):
+        :meth:`derived_stored_energy` unless closed form."""
+        if not self.stores_energy:
+            return 0.0 * d
+        return self.derived_stored_energy(d)
 
-    def static_force(self, d: float) -> float:
-        """The force (N) at rest (d' = 0) at ``d`` (m, a float): ``dU/dd`` of a connector with a potential, 0 for
-        a damper (the static equilibrium at t = 0, the early stop's potential well)."""
-        return 0.0
+    def derived_stored_energy(self, d):
+        """``integral_0^d F(s, 0) ds`` (J) by scipy's adaptive ``quad`` (relative 1e-12) on each piece between
+        0, the :attr:`kinks` and d; on an array, the distinct values, 0 and the kinks sorted, each piece between
+        neighbours integrated so and summed outward from 0 (no cancellation near 0).  inf beyond
+        :attr:`d_limit`."""
+        if np.ndim(d) == 0:
+            return self._energy_by_quad(float(d))
+        values = np.asarray(d, dtype=float)
+        flat = values.ravel()
+        mask = flat < self.d_limit
+        inside = flat[mask]
+        lo, hi = (min(float(inside.min()), 0.0), max(float(inside.max()), 0.0)) if inside.size else (0.0, 0.0)
+        points = np.unique(np.concatenate((inside, [0.0], [k for k in self.kinks if lo < k < hi])))
+        pieces = np.array([self._piece(float(a), float(b)) for a, b in zip(points[:-1], points[1:])])
+        zero = int(np.searchsorted(points, 0.0))
+        cumulative = np.zeros(points.size)
+        cumulative[zero + 1:] = np.cumsum(pieces[zero:])
+        cumulative[:zero] = -np.cumsum(pieces[:zero][::-1])[::-1]
+        out = np.full(flat.shape, np.inf)
+        out[mask] = cumulative[np.searchsorted(points, inside)]
+        return out.reshape(values.shape)
+
+    def _piece(self, start: float, end: float) -> float:
+        """``integral_start^end F(s, 0) ds`` (J) by scipy's ``quad``, relative 1e-12."""
+        return quad(lambda s: float(self.law(s, 0.0)), start, end, epsabs=0.0, epsrel=1e-12, limit=200)[0]
+
+    def _energy_by_quad(self, d: float) -> float:
+        """:meth:`derived_stored_energy` on one float."""
+        if d >= self.d_limit:
+            return math.inf
+        inner = sorted((k for k in self.kinks if min(0.0, d) < k < max(0.0, d)), reverse=d < 0.0)
+        edges = [0.0] + inner + [d]
+        return sum(self._piece(start, end) for start, end in zip(edges, edges[1:]))
 
     # ------------------------------------------------------------------ modes (overridden by switching laws)
     def provisional(self, s: list, previous):
@@ -202,16 +304,34 @@ class Connector:
         integrates the step that crosses one again in short steps)."""
         return ()
 
-    # ------------------------------------------------------------------ bounds (overridden)
+    # ------------------------------------------------------------------ bounds
     @property
     def linear_stiffness(self) -> float:
-        """Stiffness (N/m) of an always-acting linear spring ``k d^2 / 2`` (the energy bounds' quadratic form)."""
+        """Stiffness (N/m) of an always-acting linear spring ``k d^2 / 2`` (the energy bounds' quadratic form); 0
+        for any other law (its potential is then bounded otherwise: a contact's penetration, a potential well)."""
         return 0.0
 
     def force_bound(self, d_bound: float, rate_bound: float, penetration_bound: float) -> float:
         """Bound (N) on |F| given ``|d| <= d_bound`` (m), ``|d'| <= rate_bound`` (m/s) and, for a contact,
-        its penetration ``p <= penetration_bound`` (m)."""
-        return 0.0
+        its penetration ``p <= penetration_bound`` (m): :meth:`derived_force_bound` unless closed form."""
+        return self.derived_force_bound(d_bound, rate_bound)
+
+    def derived_force_bound(self, d_bound: float, rate_bound: float) -> float:
+        """The largest |F| on a :attr:`BOUND_SAMPLES` x :attr:`BOUND_SAMPLES` grid of the box ``|d| <= D``,
+        ``|d'| <= V`` (its corners and edges included) plus the largest change of F between neighbouring grid
+        points (a bound for a law monotone on each grid cell); inf for an unbounded box, one reaching
+        :attr:`d_limit` or a law not finite on it."""
+        D, V = abs(float(d_bound)), abs(float(rate_bound))
+        if not (math.isfinite(D) and math.isfinite(V)) or D >= self.d_limit:
+            return math.inf
+        d, rate = np.meshgrid(np.linspace(-D, D, self.BOUND_SAMPLES), np.linspace(-V, V, self.BOUND_SAMPLES),
+                              indexing="ij")
+        with np.errstate(all="ignore"):
+            F = np.asarray(self.law(d, rate), dtype=float) * np.ones_like(d)
+        if not np.all(np.isfinite(F)):
+            return math.inf
+        step = max(float(np.abs(np.diff(F, axis=axis)).max(initial=0.0)) for axis in (0, 1))
+        return float(np.abs(F).max()) + step
 
 
 class Load:

@@ -246,7 +246,7 @@ AGREE = {"i": model_i(100.0, 0.0), "ii": model_ii(500.0, 0.04),
 def test_the_two_independent_implementations_agree(key, new_scenes):
     """The engine's bounds (mbs_models.engine.final_metrics) and the reference's, written separately,
     give the same numbers on random states."""
-    from mbs_models.engine.final_metrics import EnergyBounds
+    from mbs_models.engine.energy_bounds import EnergyBounds
 
     scene = AGREE.get(key) or new_scenes[key]
 

@@ -4,7 +4,8 @@ A term module names the scene tables it models in ``TABLES`` and adds, in ``buil
 the bodies, connectors and roles of one such table to a
 :class:`~validation.reference.assembly.ModelBuilder` (``key`` is the table's place in the scene:
 ``"recoil_spring"``, ``"absorber"``, ``"absorber.1"``).  The connectors carry the rest of the effect:
-the force on the bodies as a function of the state, the stored energy and dissipated power, the
+their force law (mandatory, :class:`~validation.reference.model.Connector`) and what is derived from it unless
+given in closed form -- the stored energy and dissipated power, the
 switching surfaces and how the mode is classified at a restart, and the contribution to the energy
 bounds of the early stop (:mod:`validation.reference.model`).  Adding an effect to the reference is
 adding one module here; a user's element defined outside the package registers its term with
@@ -59,7 +60,7 @@ def register_term(term) -> object:
 
     ``term`` is a module (or any object) with ``TABLES`` (the scene table names it models) and
     ``build(builder, key, table)`` (adds its bodies and connectors, subclasses of
-    :class:`validation.reference.model.Connector`, to the builder), exactly like the term modules of this
+    :class:`validation.reference.model.Connector` with their ``law``, to the builder), exactly like the term modules of this
     package.  Registering the same term again does nothing, and the same definition imported again (its module
     reloaded) replaces the first; a table that already has another term, or a term without ``TABLES`` or
     ``build``, is a TypeError.  The engine's side is

@@ -137,25 +137,55 @@ class ContactConnector(Connector):
 
     def __init__(self, name: str, a: str, b: str, offset: float, law: Law, compression_only: bool = False):
         super().__init__(name, a, b)
-        self.offset, self.law = float(offset), law
+        self.offset, self.contact_law = float(offset), law
         self.compression_only = bool(compression_only)
         if self.compression_only and law.name != "hunt-crossley":
             raise ReferenceModelError(f"{name}: compression_only is a reading of the hunt-crossley law")
         self.injects_energy = law.damping_factor < 0
 
     # ------------------------------------------------------------------ the law
+    @property
+    def kinks(self) -> tuple[float, ...]:
+        """The offset (m): no force at rest before it, ``k p^n`` after."""
+        return (self.offset,)
+
+    def law(self, d, rate, state: ContactMode | None = None):
+        """The physical force (N, floats or arrays; module docstring): 0 while ``p <= 0``; while ``p > 0`` the
+        law clipped to >= 0 -- ``k p^n (1 + a p')`` with the damping factor a of the episode ``state`` (None: the
+        largest, an onset at or below the floor), ``k p + c p'``, ``k p^n``; under ``compression_only`` only while
+        ``p' > 0``."""
+        law = self.contact_law
+        factor = state.factor if state is not None else (law.largest_factor if law.name in RESTITUTION_LAWS
+                                                         else law.damping_factor)
+        if np.ndim(d) == 0 and np.ndim(rate) == 0:
+            p = d - self.offset
+            if p <= 0.0 or (self.compression_only and rate <= 0.0):
+                return 0.0
+            raw = law.stiffness * p + law.damping * rate if law.kelvin_voigt else \
+                law.stiffness * p ** law.exponent * (1.0 + factor * rate)
+            return max(raw, 0.0)
+        p = np.asarray(d, dtype=float) - self.offset + 0.0 * np.asarray(rate, dtype=float)
+        rate = np.asarray(rate, dtype=float) + 0.0 * p
+        positive = np.maximum(p, 0.0)
+        if law.kelvin_voigt:
+            raw = law.stiffness * positive + law.damping * rate
+        else:
+            raw = law.stiffness * positive ** law.exponent * (1.0 + factor * rate)
+        acting = (p > 0.0) & (rate > 0.0) if self.compression_only else p > 0.0
+        return np.where(acting, np.maximum(raw, 0.0), 0.0)
+
     def surface(self, p, rate, factor):
         """The clipping surface's function: ``1 + a p'`` (power laws), ``p + (c/k) p'`` (m, Kelvin-Voigt)."""
-        if self.law.kelvin_voigt:
-            return p + self.law.damping / self.law.stiffness * rate
+        if self.contact_law.kelvin_voigt:
+            return p + self.contact_law.damping / self.contact_law.stiffness * rate
         return 1.0 + factor * rate
 
     def surface_rate(self, rate, acceleration, factor):
         """Its time derivative: ``a p''`` or ``p' + (c/k) p''`` (only its sign is read: an extreme factor's product
         may overflow to +-inf, without a warning)."""
         with np.errstate(over="ignore"):
-            if self.law.kelvin_voigt:
-                return rate + self.law.damping / self.law.stiffness * acceleration
+            if self.contact_law.kelvin_voigt:
+                return rate + self.contact_law.damping / self.contact_law.stiffness * acceleration
             return factor * acceleration
 
     def equations(self, state: ContactMode) -> Equations | None:
@@ -163,7 +193,7 @@ class ContactConnector(Connector):
         p < 0, ``sign(p) |p|^n``, so that the law stays smooth across the segment's end)."""
         if state.phase == OFF and not state.penetrated:
             return None
-        law = self.law
+        law = self.contact_law
         constants = dict(k=law.stiffness, n=law.exponent, offset=self.offset)
         elastic = """
             p = {xb} - {xa} - {offset}
@@ -198,22 +228,22 @@ class ContactConnector(Connector):
             return 0.0 * rate
         if state.phase == STICK:
             return None
-        k, n = self.law.stiffness, self.law.exponent
-        if self.law.kelvin_voigt:
-            return k * rate + self.law.damping * acceleration
+        k, n = self.contact_law.stiffness, self.contact_law.exponent
+        if self.contact_law.kelvin_voigt:
+            return k * rate + self.contact_law.damping * acceleration
         pp = np.maximum(d - self.offset, 0.0)
         dpow = n * np.where(pp > 0, pp, 1.0) ** (n - 1.0) * (pp > 0)
         return k * (dpow * rate * (1.0 + state.factor * rate) + pp ** n * state.factor * acceleration)
 
     def stored_energy(self, d):
         """``U = k max(p, 0)^(n+1) / (n+1)`` (J)."""
-        n = self.law.exponent
-        return self.law.stiffness * np.maximum(d - self.offset, 0.0) ** (n + 1.0) / (n + 1.0)
+        n = self.contact_law.exponent
+        return self.contact_law.stiffness * np.maximum(d - self.offset, 0.0) ** (n + 1.0) / (n + 1.0)
 
     def static_force(self, d: float) -> float:
         """The force at rest (p' = 0): ``k max(p, 0)^n`` (N), every law (the damping terms vanish)."""
         p = d - self.offset
-        return self.law.stiffness * p ** self.law.exponent if p > 0.0 else 0.0
+        return self.contact_law.stiffness * p ** self.contact_law.exponent if p > 0.0 else 0.0
 
     # ------------------------------------------------------------------ modes
     def _episode(self, rate: float, previous: ContactMode | None) -> tuple[float, float]:
@@ -221,7 +251,7 @@ class ContactConnector(Connector):
         if previous is not None and previous.penetrated:
             return previous.factor, previous.onset_rate
         onset = max(rate, 0.0)
-        return self.law.episode_factor(onset), onset
+        return self.contact_law.episode_factor(onset), onset
 
     def provisional(self, s, previous):
         """The previous state, or at t = 0 the law acting iff p > 0."""
@@ -243,8 +273,8 @@ class ContactConnector(Connector):
         if not (hints["p"] if "p" in hints else heading(p, rate, free)):
             return ContactMode(OFF)
         factor, onset = self._episode(rate, restart.previous_state(self))
-        if self.law.has_clipping_surface:
-            tol = TOL_POS if self.law.kelvin_voigt else TOL_S
+        if self.contact_law.has_clipping_surface:
+            tol = TOL_POS if self.contact_law.kelvin_voigt else TOL_S
             if not (hints["s"] if "s" in hints else heading(self.surface(p, rate, factor),
                                                              self.surface_rate(rate, free, factor), tol=tol)):
                 return ContactMode(OFF, True, True, factor, onset)
@@ -261,7 +291,7 @@ class ContactConnector(Connector):
             return ON if rate > 0 else OFF
         # on the surface p' = 0: the force is k p^n (1 + lambda 0) if compressing, 0 otherwise
         m_red = self.mass_b * self.mass_a / (self.mass_b + self.mass_a)
-        with_force = free - self.law.stiffness * max(p, 0.0) ** self.law.exponent / m_red
+        with_force = free - self.contact_law.stiffness * max(p, 0.0) ** self.contact_law.exponent / m_red
         if with_force > 0:
             return ON       # even with the force the bodies keep approaching
         if free <= 0:
@@ -273,16 +303,16 @@ class ContactConnector(Connector):
         d_of, rate_of, offset, dy = self.d_of, self.rate_of, self.offset, restart.dy
         if state.phase == STICK:
             sliding_force = restart.force_function(self)
-            k, n = self.law.stiffness, self.law.exponent
+            k, n = self.contact_law.stiffness, self.contact_law.exponent
 
             def slip(t, y):
                 return sliding_force(t, y) - k * np.maximum(d_of(y) - offset, 0.0) ** n
             return [("release", sliding_force, True, None, 0.0), ("slip", slip, False, None, 0.0)]
         items = [("p", lambda t, y: d_of(y) - offset, state.penetrated, d_of(dy), restart.position_noise(offset))]
-        if state.penetrated and self.law.has_clipping_surface:
+        if state.penetrated and self.contact_law.has_clipping_surface:
             factor, surface = state.factor, self.surface
-            if self.law.kelvin_voigt:
-                noise = restart.position_noise(offset) + self.law.damping / self.law.stiffness * restart.velocity_noise
+            if self.contact_law.kelvin_voigt:
+                noise = restart.position_noise(offset) + self.contact_law.damping / self.contact_law.stiffness * restart.velocity_noise
             else:
                 noise = restart.velocity_noise * max(1.0, abs(factor))
             items.append(("s", lambda t, y: surface(d_of(y) - offset, rate_of(y), factor), not state.clipped,
@@ -295,19 +325,19 @@ class ContactConnector(Connector):
         """The release ``p = 0`` of a penetrated power law: ``k p^n`` (n != 1) is only C^1 at p = 0, so the
         solver's step that crosses it may be long and its error estimate blind (seen: a 1 ms step losing
         3e-6 of the restitution of a free Flores impact)."""
-        return ("p",) if state.penetrated and self.law.exponent != 1.0 else ()
+        return ("p",) if state.penetrated and self.contact_law.exponent != 1.0 else ()
 
     # ------------------------------------------------------------------ bounds
     def penetration_bound(self, energy: float) -> float:
         """``((n+1) E / k)^(1/(n+1))`` (m): the contact's own potential cannot exceed E (J)."""
-        n = self.law.exponent
-        return ((n + 1.0) * max(energy, 0.0) / self.law.stiffness) ** (1.0 / (n + 1.0))
+        n = self.contact_law.exponent
+        return ((n + 1.0) * max(energy, 0.0) / self.contact_law.stiffness) ** (1.0 / (n + 1.0))
 
     def force_bound(self, d_bound: float, rate_bound: float, penetration_bound: float) -> float:
         """``k p^n (1 + a_max |p'|)`` or ``k p + c |p'|`` (N) at the bounds; 0 if p cannot become > 0."""
         p = penetration_bound
         if p <= 0:
             return 0.0
-        if self.law.kelvin_voigt:
-            return self.law.stiffness * p + self.law.damping * rate_bound
-        return self.law.stiffness * p ** self.law.exponent * (1.0 + self.law.largest_factor * rate_bound)
+        if self.contact_law.kelvin_voigt:
+            return self.contact_law.stiffness * p + self.contact_law.damping * rate_bound
+        return self.contact_law.stiffness * p ** self.contact_law.exponent * (1.0 + self.contact_law.largest_factor * rate_bound)

@@ -29,6 +29,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from ..model import BARREL, GROUND, ConstantLoad, Connector, Equations, ReferenceModelError
 from ..switching import TOL_VEL
 
@@ -44,6 +46,7 @@ class CoulombFriction(Connector):
     """Exact Coulomb friction ``mu N`` (N) between the ground ``a`` and a body ``b`` (module docstring)."""
 
     dissipates = True
+    stores_energy = False
     classify_pass = 1
 
     def __init__(self, name: str, a: str, b: str, force: float):
@@ -51,6 +54,14 @@ class CoulombFriction(Connector):
             raise ReferenceModelError(f"{name}: friction is modelled between the ground and a body")
         super().__init__(name, a, b)
         self.force = float(force)
+
+    def law(self, d, rate, state=None):
+        """``F = mu N sign(d')`` (N) while slipping (floats or arrays).  At d' = 0 the friction is the constraint
+        force that holds the body (:meth:`equations` in ``stick``), anything in ``[-mu N, mu N]``: the law gives 0
+        there, so that ``F(d, 0) = 0`` (no stored energy)."""
+        if np.ndim(d) == 0 and np.ndim(rate) == 0:
+            return math.copysign(self.force, rate) if rate != 0 else 0.0
+        return self.force * np.sign(np.asarray(rate, dtype=float) + 0.0 * np.asarray(d, dtype=float))
 
     def equations(self, state) -> Equations:
         """``F = +-mu N`` while slipping; while stuck, the constraint ``F = f_b`` (every other force on b);

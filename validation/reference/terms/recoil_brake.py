@@ -31,6 +31,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from ..model import BARREL, GROUND, Connector, Equations
 from ..switching import TOL_VEL, heading
 
@@ -67,6 +69,7 @@ class RecoilBrake(Connector):
     """``F = rho A^3 d'|d'| / (2 Cd^2 a(d)^2)`` between ``a`` and ``b`` (module docstring)."""
 
     dissipates = True
+    stores_energy = False
     classify_pass = 2
 
     def __init__(self, name: str, a: str, b: str, piston_area: float, orifice_area, discharge_coefficient: float,
@@ -94,6 +97,18 @@ class RecoilBrake(Connector):
         return a0, (a1 - a0) / (x1 - x0), x0
 
     # ------------------------------------------------------------------ the law
+    def law(self, d, rate, state=None):
+        """``F = rho A^3 d'|d'| / (2 (Cd a(d))^2)`` (N), a(d) of the branch of d''s sign (floats or arrays)."""
+        if np.ndim(d) == 0 and np.ndim(rate) == 0:
+            area = interpolate(self.points(rate > 0), d)
+            return self.coefficient * rate * abs(rate) / (area * area)
+        d = np.asarray(d, dtype=float) + 0.0 * np.asarray(rate, dtype=float)
+        rate = np.asarray(rate, dtype=float) + 0.0 * d
+        recoil, counter = (np.interp(d, [x for x, _ in points], [a for _, a in points])
+                           for points in (self.recoil_points, self.counter_points))
+        area = np.where(rate > 0, recoil, counter)
+        return self.coefficient * rate * np.abs(rate) / (area * area)
+
     def equations(self, state: BrakeState) -> Equations:
         """``F = +-K d'^2`` with ``K = coefficient / a(d)^2`` on the piece; dissipated power ``F d'``."""
         sign = 1.0 if state.recoil else -1.0

@@ -11,6 +11,8 @@ damper's force is 0 there on either branch), or the crossing direction if ``a_M 
 
 from __future__ import annotations
 
+import numpy as np
+
 from ..model import BARREL, GROUND, Connector, Equations
 from ..switching import TOL_VEL
 
@@ -21,6 +23,7 @@ class RecoilDamper(Connector):
     """The asymmetric damper ``F = c(d') d'`` between ``a`` and ``b`` (module docstring)."""
 
     dissipates = True
+    stores_energy = False
 
     def __init__(self, name: str, a: str, b: str, recoil: float, counter_recoil: float):
         super().__init__(name, a, b)
@@ -31,6 +34,13 @@ class RecoilDamper(Connector):
     def coefficient(self, state) -> float:
         """c (N s/m) on the branch ``state`` (True or None: recoil)."""
         return self.counter_recoil if state is False else self.recoil
+
+    def law(self, d, rate, state=None):
+        """``F = c(d') d'`` (N): ``recoil`` for d' > 0, ``counter_recoil`` otherwise (floats or arrays)."""
+        if np.ndim(rate) == 0 and np.ndim(d) == 0:
+            return (self.recoil if rate > 0 else self.counter_recoil) * rate
+        rate = np.asarray(rate, dtype=float) + 0.0 * np.asarray(d, dtype=float)
+        return np.where(rate > 0, self.recoil, self.counter_recoil) * rate
 
     def equations(self, state) -> Equations:
         """``F = c d'``, dissipated power ``c d'^2``."""

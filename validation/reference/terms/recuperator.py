@@ -43,6 +43,7 @@ class GasSpring(Connector):
     """``F = p0 A (V0 / (V0 - A d))^n`` between ``a`` and ``b`` (module docstring)."""
 
     stores_energy = True
+    dissipates = False
     nonlinear_potential = True
 
     def __init__(self, name: str, a: str, b: str, pressure: float, area: float, volume: float, exponent: float):
@@ -51,6 +52,16 @@ class GasSpring(Connector):
         self.volume, self.exponent = float(volume), float(exponent)
         self.preload = self.pressure * self.area
         self.d_limit = self.volume / self.area
+
+    def law(self, d, rate, state=None):
+        """``F = p0 A (V0 / (V0 - A d))^n`` (N); inf at or beyond ``d = V0 / A`` (floats or arrays)."""
+        if np.ndim(d) == 0 and np.ndim(rate) == 0:
+            return self.static_force(d) if self.volume - self.area * d > 0.0 else math.inf
+        d = np.asarray(d, dtype=float) + 0.0 * np.asarray(rate, dtype=float)
+        room = self.volume - self.area * d
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            return np.where(room > 0.0, self.preload * (self.volume / np.where(room > 0.0, room, 1.0)) ** self.exponent,
+                            np.inf)
 
     def equations(self, state) -> Equations:
         """``F = p0 A (V0 / (V0 - A d))^n``; no dissipated power.  A trial state of the solver beyond the gas

@@ -22,6 +22,10 @@ class LinearSpringDamper(Connector):
         self.dissipates = self.damping > 0
         self.stores_energy = self.stiffness > 0
 
+    def law(self, d, rate, state=None):
+        """``F = k d + c d'`` (N)."""
+        return self.stiffness * d + self.damping * rate
+
     def equations(self, state) -> Equations:
         """``F = k d + c d'``; the dissipated power ``c d'^2``."""
         k, c = self.stiffness, self.damping

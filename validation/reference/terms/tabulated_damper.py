@@ -9,6 +9,8 @@ the classified mode (F is continuous, so they do not depend on the piece chosen)
 
 from __future__ import annotations
 
+import numpy as np
+
 from ..model import BARREL, GROUND, Connector, Equations
 from .tabulated import Table
 
@@ -19,11 +21,18 @@ class TabulatedDamper(Connector):
     """``F = F(d')`` tabulated between ``a`` and ``b`` (module docstring); the state is the piece of d'."""
 
     dissipates = True
+    stores_energy = False
     classify_pass = 2
 
     def __init__(self, name: str, a: str, b: str, points):
         super().__init__(name, a, b)
         self.table = Table(points)
+
+    def law(self, d, rate, state=None):
+        """``F(d')`` (N) from the table, each d' on its own piece (floats or arrays)."""
+        if np.ndim(d) == 0 and np.ndim(rate) == 0:
+            return self.table.value(rate)
+        return self.table.values(np.asarray(rate, dtype=float) + 0.0 * np.asarray(d, dtype=float))
 
     def equations(self, state) -> Equations:
         start, value, slope = self.table.pieces[state]
