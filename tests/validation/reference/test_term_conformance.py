@@ -24,6 +24,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import conformance
+
 from mbs_models import load_scene
 from mbs_models.elements.ops import PYTHON_OPS
 from mbs_models.engine.mechanism import Mechanism
@@ -58,13 +60,8 @@ def boxes(connector) -> tuple[tuple[float, float], ...]:
 
 
 def states(connector, box, count: int = 48, seed: int = 0) -> list[tuple[float, float]]:
-    """(d, d') in the box: its corners, edge midpoints, the centre and random points."""
-    D, V = box
-    rng = np.random.default_rng(seed)
-    unit = [(-1.0, -1.0), (-1.0, 1.0), (1.0, -1.0), (1.0, 1.0), (0.0, 1.0), (1.0, 0.0), (0.0, -1.0), (-1.0, 0.0),
-            (0.0, 0.0)] + [tuple(rng.uniform(-1.0, 1.0, 2)) for _ in range(count)]
-    offset = connector.offset if connector.is_contact else 0.0
-    return [(offset + u * D, w * V) for u, w in unit]
+    """(d, d') in the box: its corners, edge midpoints, the centre and random points (tests/conformance.py's)."""
+    return conformance.states(connector, box, count, seed)
 
 
 def close(a: float, b: float, scale: float, tolerance: float = FORCE_TOLERANCE) -> bool:
