@@ -174,3 +174,20 @@ def test_the_module_imported_twice_registers_its_second_definition():
               "      TERMS['progressive_spring'] is progressive_spring.ReferenceTerm,\n"
               "      type(scene.progressive_spring) is progressive_spring.ProgressiveSpring)\n")
     assert _run(["-c", script]).split() == ["True", "True", "True"]
+
+
+def test_the_optimiser_minimises_the_declared_metric_with_the_plugin(tmp_path):
+    """``recoil --plugin ... optimise`` over the new table's key, minimising the element's declared metric: the
+    optimum's objective is that metric, and it is the spring's force at the run's maximum displacement
+    (F = k1 x + k3 x^3, the peak of a spring whose force rises with x, within 0.1 %)."""
+    import tomllib
+
+    _run(["-m", "mbs_models", "--plugin", str(EXAMPLE), "optimise", str(SCENE), "--vary",
+          "progressive_spring.cubic_stiffness=0:4e6", "--minimise", "progressive_spring.peak_force", "--end-time", "2",
+          "--popsize", "3", "--maxiter", "1", "--accuracy", "draft", "--out", str(tmp_path)])
+    optimum = json.loads((tmp_path / "optimum.json").read_text())
+    metrics, k3 = optimum["metrics"], optimum["parameters"]["progressive_spring.cubic_stiffness"]
+    assert optimum["objective"] == metrics["progressive_spring.peak_force"] and 0.0 <= k3 <= 4e6
+    k1 = tomllib.loads(SCENE.read_text())["progressive_spring"]["linear_stiffness"]
+    x = metrics["max_barrel_displacement"]
+    assert optimum["objective"] == pytest.approx(k1 * x + k3 * x ** 3, rel=1e-3)
