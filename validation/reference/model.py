@@ -127,7 +127,8 @@ class Connector(abc.ABC):
        :attr:`dissipates` (False only where ``F(d, d') = F(d, 0)``: a spring), :attr:`kinks` (the d where
        ``F(d, 0)`` or its slope jumps), :attr:`d_limit`, :attr:`injects_energy`, :attr:`is_contact`,
        :attr:`nonlinear_potential` (its potential is neither ``k d^2 / 2`` nor >= 0: the early stop bounds it
-       with its body's stops, :mod:`validation.reference.finality`).
+       with its body's stops, :mod:`validation.reference.finality`; derived by default: every potential that is
+       not declared quadratic by :attr:`linear_stiffness` nor a contact's).
     4. Optionally give closed forms, each replacing a derived default and checked against it:
        :meth:`stored_energy`, :meth:`static_force`, :meth:`force_bound`, :attr:`linear_stiffness` (the
        stiffness of an always-acting linear spring: the energy bounds' quadratic form), :meth:`force_rate`
@@ -154,7 +155,6 @@ class Connector(abc.ABC):
     stores_energy = True
     classify_pass = 0
     injects_energy = False
-    nonlinear_potential = False
     d_limit = float("inf")
     #: Samples per axis of the box in the derived force bound.
     BOUND_SAMPLES = 41
@@ -305,6 +305,14 @@ class Connector(abc.ABC):
         return ()
 
     # ------------------------------------------------------------------ bounds
+    @property
+    def nonlinear_potential(self) -> bool:
+        """True where the potential is bounded by the early stop's potential well, not by its quadratic form: by
+        default every potential that is neither declared ``k d^2 / 2`` (:attr:`linear_stiffness` > 0) nor a
+        contact's (bounded by its penetration) -- so a term that forgets to say so is never left out of the
+        bounds.  A term declares it as a class attribute to say so explicitly."""
+        return bool(self.stores_energy) and not self.is_contact and not self.linear_stiffness > 0
+
     @property
     def linear_stiffness(self) -> float:
         """Stiffness (N/m) of an always-acting linear spring ``k d^2 / 2`` (the energy bounds' quadratic form); 0

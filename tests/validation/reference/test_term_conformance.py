@@ -293,3 +293,17 @@ def test_a_law_written_differently_is_caught(key):
     wrong.__dict__.update(reference.__dict__)
     with pytest.raises(AssertionError, match="engine F"):
         check_same_law(key, ENGINE[key], wrong)
+
+
+def test_a_potential_is_in_the_early_stops_bounds_unless_declared_otherwise(monkeypatch):
+    """The reference's share of the energy bounds is derived: a law-only progressive spring is a nonlinear
+    potential (the potential well bounds it) without saying so; a linear spring (k d^2 / 2), a contact and a
+    damper are not."""
+    monkeypatch.setattr(_Term, "connector", _LawOnly)
+    monkeypatch.setitem(terms.TERMS, "recoil_spring", _Term)
+    spring = build_model(SCENES["simplified"]).connector("recoil_spring")
+    assert spring.linear_stiffness == 0.0 and spring.nonlinear_potential is True
+    monkeypatch.undo()
+    model = build_model(SCENES["model_ii"])
+    assert [c.name for c in model.connectors if c.nonlinear_potential] == []
+    assert model.connector("recoil_spring").linear_stiffness > 0.0
