@@ -302,6 +302,11 @@ def death_reason(processes) -> str:
             process.join(timeout=5.0)   # the pool reports its death before it has reaped the process
         except (AssertionError, OSError, ValueError):
             pass
+        # the pool's own thread may be reaping it at the same time: whichever waitpid loses sees no status until
+        # the winner has stored it on the shared Popen (a few microseconds; seconds on a loaded machine)
+        deadline = time.monotonic() + 5.0
+        while process.exitcode is None and time.monotonic() < deadline:
+            time.sleep(0.01)
         if process.exitcode:
             codes.append(process.exitcode)
     how = ""

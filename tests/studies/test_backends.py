@@ -303,6 +303,7 @@ def test_a_task_that_kills_its_workers_is_a_cluster_error():
             DaskBackend(cluster.scheduler_address) as backend:
         with pytest.raises(ClusterError) as info:
             list(backend.run(os._exit, [1]))
+        cluster.wait_for_workers(1, timeout=60)   # its nanny restarts the worker: close once it has (see below)
     assert str(info.value).startswith("Dask workers kept dying while running one task (killed, out of memory?), "
                                       f"and the scheduler {cluster.scheduler_address} gave it up: ")
 
@@ -355,13 +356,8 @@ def test_a_task_that_kills_its_worker_is_lost_and_the_others_run(sig, named):
         done, lost = _flat(backend.run(_poisoned, _tasks(batches, {13}, getattr(signal, sig)), split=_by_number,
                                        lost=_lost))
         assert done == [2 * x for x in range(30) if x != 13]
-        # the signal is named when the dead process's status can still be read; in the whole suite on a loaded
-        # machine it sometimes cannot (the status went elsewhere), and the row then says only that it died
-        [(tag, number, reason)] = lost
-        assert (tag, number) == ("lost", 13)
-        assert reason in (f"its worker process {named} each of the 3 times it ran it (in its batch, again, then "
-                          "alone)", "its worker process died each of the 3 times it ran it (in its batch, again, "
-                                    "then alone)"), reason
+        assert lost == [("lost", 13, f"its worker process {named} each of the 3 times it ran it (in its batch, "
+                                     "again, then alone)")]
         assert _flat(backend.run(_poisoned, _tasks([[1], [2]], set()))) == ([2, 4], [])
 
 
@@ -428,5 +424,8 @@ def test_a_task_that_kills_its_dask_workers_is_lost():
             with DaskBackend(cluster.scheduler_address) as backend:
                 done, lost = _flat(backend.run(poisoned, _tasks([[i, i + 1] for i in range(0, 20, 2)], {13}),
                                                split=_by_number, lost=_lost))
+            # the nannies restart the killed workers: closing the cluster while one is half started fails inside
+            # distributed ("can only join a started process"), so wait for them first
+            cluster.wait_for_workers(2, timeout=60)
     assert done == [2 * x for x in range(20) if x != 13]
     assert lost == [("lost", 13, "the Dask workers running it died each time the scheduler tried it (KilledWorker)")]
