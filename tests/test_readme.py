@@ -131,3 +131,23 @@ def test_readme_optimised_absorbers_are_the_scripts_and_the_engines():
         result = simulate(scene, 10.0)
         assert (length, force) == (f"{result.max_barrel_displacement * 1e3:.2f}",
                                    f"{result.peak_support_force / 1e3:.3f}"), (mount, design, mass)
+
+
+def test_the_own_element_example_is_the_example_modules_law():
+    """The README's "Adding your own element" block, run in a process of its own (it registers a table), gives the
+    run of ``examples/progressive_spring.py`` bit for bit (one law, written twice: the README's copy cannot drift)."""
+    import subprocess
+    import sys
+
+    root = README.parent
+    block = _python_block_after("### Adding your own element")
+    run = ("from mbs_models import load_scene, simulate\n"
+           "r = simulate(load_scene('examples/progressive_spring.toml'), 0.5, 'draft')\n"
+           "print(r.max_barrel_displacement.hex(), r.peak_support_force.hex())\n")
+    outputs = []
+    for prelude in (block, "import runpy; runpy.run_path('examples/progressive_spring.py')\n"):
+        done = subprocess.run([sys.executable, "-c", prelude + "\n" + run], capture_output=True, text=True, cwd=root,
+                              timeout=300)
+        assert done.returncode == 0, done.stderr[-2000:]
+        outputs.append(done.stdout.split()[-2:])
+    assert outputs[0] == outputs[1]
