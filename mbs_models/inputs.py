@@ -12,11 +12,14 @@ problem is one :class:`~mbs_models.errors.SceneError` naming the key the caller 
 
 from __future__ import annotations
 
+import csv
+import io
 import os
 import re
 import stat
 import tomllib
 from pathlib import Path
+from typing import Callable
 
 from .errors import SceneError
 
@@ -70,6 +73,34 @@ def read_text_file(path: str | Path, key: str, what: str, max_bytes: int | None 
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:
         raise SceneError(key, f"cannot read {what} {path}: not UTF-8 text (byte {exc.start})") from None
+
+
+def read_two_columns(path: str | Path, key: str, what: str, columns: str, max_rows: int,
+                     too_many: Callable[[], SceneError]) -> list[tuple[float, float]]:
+    """The number pairs of a CSV file of two columns (``columns``, e.g. ``"time,force"``) after one header line: a
+    file within the input limits (:func:`read_text_file`, ``what`` names it), at most ``max_rows`` pairs
+    (``too_many()`` is the error past them).  Every error is a SceneError naming ``key``."""
+    text = read_text_file(path, key, what)
+    rows = []
+    try:
+        for row in csv.reader(io.StringIO(text, newline="")):
+            if row and any(cell.strip() for cell in row):
+                rows.append(row)
+                if len(rows) > max_rows + 1:  # the header and the pairs
+                    raise too_many()
+    except csv.Error as exc:  # a field beyond csv's limit (128 KiB), a NUL byte
+        raise SceneError(key, f"{path}: not a CSV table of two columns {columns}: {exc}") from None
+    if len(rows) < 3:
+        raise SceneError(key, f"{path}: needs a header line and at least two rows {columns}")
+    out = []
+    for line, row in enumerate(rows[1:], start=2):
+        if len(row) != 2:
+            raise SceneError(key, f"{path} line {line}: needs two columns {columns}, got {len(row)}")
+        try:
+            out.append((float(row[0]), float(row[1])))
+        except ValueError:
+            raise SceneError(key, f"{path} line {line}: not numbers: {','.join(row)[:80]!r}") from None
+    return out
 
 
 def bracket_nesting(text: str) -> int:

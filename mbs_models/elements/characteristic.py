@@ -24,8 +24,6 @@ end segments' extrapolation ``k_0 min(s - s_0, 0) + k_(n-2) max(s - s_(n-1), 0)`
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 import warnings
 from dataclasses import dataclass
@@ -35,7 +33,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ..errors import SceneError
-from ..inputs import read_text_file
+from ..inputs import read_two_columns
 from .ops import Ops, piecewise_linear
 from .table import Rule, Table, check_number
 
@@ -52,27 +50,9 @@ def read_pairs_file(path: Path, key: str, columns: str) -> list[list[float]]:
     """The ``(s, F)`` rows of a CSV file of two columns (``columns``, e.g. ``"displacement,force"``) after one
     header line: a regular UTF-8 text file within the input limits (:func:`~mbs_models.inputs.read_text_file`),
     at most :data:`MAX_POINTS` rows.  SceneError naming ``key`` otherwise."""
-    text = read_text_file(path, key, "characteristic file")
-    rows = []
-    try:
-        for row in csv.reader(io.StringIO(text, newline="")):
-            if row and any(cell.strip() for cell in row):
-                rows.append(row)
-                if len(rows) > MAX_POINTS + 1:
-                    raise SceneError(key, f"{path} has more than {MAX_POINTS} points: resample the characteristic")
-    except csv.Error as exc:
-        raise SceneError(key, f"{path}: not a CSV table of two columns {columns}: {exc}") from None
-    if len(rows) < 3:
-        raise SceneError(key, f"{path}: needs a header line and at least two rows {columns}")
-    out = []
-    for line, row in enumerate(rows[1:], start=2):
-        if len(row) != 2:
-            raise SceneError(key, f"{path} line {line}: needs two columns {columns}, got {len(row)}")
-        try:
-            out.append([float(row[0]), float(row[1])])
-        except ValueError:
-            raise SceneError(key, f"{path} line {line}: not numbers: {','.join(row)[:80]!r}") from None
-    return out
+    too_many = SceneError(key, f"{path} has more than {MAX_POINTS} points: resample the characteristic")
+    return [list(pair) for pair in read_two_columns(path, key, "characteristic file", columns, MAX_POINTS,
+                                                    lambda: too_many)]
 
 
 def resolve_points(table, key: str, columns: str, units: tuple[str, str]) -> tuple[tuple[float, float], ...]:

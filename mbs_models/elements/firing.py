@@ -34,8 +34,6 @@ summary).
 from __future__ import annotations
 
 import contextvars
-import csv
-import io
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -44,7 +42,7 @@ from typing import ClassVar
 import numpy as np
 
 from ..errors import SceneError
-from ..inputs import read_text_file
+from ..inputs import read_two_columns
 from .barrel import BARREL
 from .connector import Load
 from .declaration import Metric, Outputs
@@ -79,28 +77,9 @@ def read_pulse_file(path: Path, key: str) -> tuple[tuple[float, ...], tuple[floa
     """(times s, forces N) from a CSV file of two columns ``time,force`` after one header line: a regular UTF-8
     text file of at most :data:`~mbs_models.inputs.MAX_INPUT_BYTES` (:func:`~mbs_models.inputs.read_text_file`:
     no device such as ``/dev/zero``, directory or pipe) with at most :data:`MAX_PULSE_POINTS` points."""
-    text = read_text_file(path, key, "pulse file")
-    rows = []
-    try:
-        for row in csv.reader(io.StringIO(text, newline="")):
-            if row and any(cell.strip() for cell in row):
-                rows.append(row)
-                if len(rows) > MAX_PULSE_POINTS + 1:  # the header and the points
-                    raise _too_many_points(key, f"{path} has")
-    except csv.Error as exc:  # a field beyond csv's limit (128 KiB), a NUL byte
-        raise SceneError(key, f"{path}: not a CSV table of two columns time,force: {exc}") from None
-    if len(rows) < 3:
-        raise SceneError(key, f"{path}: needs a header line and at least two rows time,force")
-    times, forces = [], []
-    for line, row in enumerate(rows[1:], start=2):
-        if len(row) != 2:
-            raise SceneError(key, f"{path} line {line}: needs two columns time,force, got {len(row)}")
-        try:
-            times.append(float(row[0]))
-            forces.append(float(row[1]))
-        except ValueError:
-            raise SceneError(key, f"{path} line {line}: not numbers: {','.join(row)[:80]!r}") from None
-    return tuple(times), tuple(forces)
+    pairs = read_two_columns(path, key, "pulse file", "time,force", MAX_PULSE_POINTS,
+                             lambda: _too_many_points(key, f"{path} has"))
+    return tuple(t for t, _ in pairs), tuple(f for _, f in pairs)
 
 
 def _impulse(t, f) -> float:
