@@ -210,21 +210,6 @@ def check_name(key: str, name) -> str:
     return name
 
 
-def check_unique_name(scene, table, key: str) -> None:
-    """SceneError naming ``key.name`` if another element, body or connector of ``scene`` has the same name
-    (outputs and energies are keyed by it)."""
-    taken, passed = [], False
-    for element, other in scene.elements():
-        passed = passed or other is table
-        if other is table or (passed and type(other) is type(table)):  # a later one of its kind names itself
-            continue
-        taken.append(element)
-        taken += [b.name for b in other.bodies(scene, element)] + [c.name for c in other.connectors(scene, element)]
-    if table.name in taken:
-        raise SceneError(f"{key}.name", f"{table.name!r} is taken by another element or its connector: every "
-                                        f"element needs its own name")
-
-
 def scene_key(scene, table, default: str) -> str:
     """``table``'s key in ``scene`` (``tabulated_spring`` or ``tabulated_spring.1``)."""
     return next((key for key, other in scene.tables() if other is table), default)
@@ -282,9 +267,6 @@ class CharacteristicTable(Table):
         else:
             out["points"] = [list(p) for p in self.pairs]
         return out
-
-    def check_in_scene(self, scene, key: str) -> None:
-        check_unique_name(scene, self, key)
 
     def implausible(self, key: str) -> list[tuple[str, str]]:
         """A table reaching beyond ``MAX_EXTENT`` (a UnitWarning: ``mbs_models.scene.plausibility``)."""

@@ -196,17 +196,20 @@ class Scene:
         """Every body, connector and load of the assembled mechanism has its own name, and no element is named
         like another element's item: outputs are keyed by these names and ``Result.energy()`` groups them by
         element, so a shared name would merge or misattribute entries.  Only an absorber's name is the user's
-        (the other elements' names are fixed and distinct), so this runs when one is named; the error names
-        that absorber's key (``absorber.N.name``)."""
-        if not any(absorber.name for absorber in self.absorbers):
+        (the other elements' names are fixed and distinct) or that of an element named by the user (a
+        ``[[tabulated_spring]]``'s ``name``), so this runs when one is named; the error names that element's key
+        (``absorber.N.name``, ``tabulated_spring.1.name``)."""
+        keys = {id(table): key for key, table in self.tables()
+                if isinstance(table, Absorber) or isinstance(getattr(table, "name", None), str)}
+        if not any(table.name for _, table in self.tables() if id(table) in keys):
             return
-        absorber_keys = iter(key for key, _ in self._absorber_keys())
-        elements = [(name, table, next(absorber_keys) if isinstance(table, Absorber) else None)
-                    for name, table in self.elements()]
+        elements = [(name, table, keys.get(id(table))) for name, table in self.elements()]
 
         def described(index: int) -> str:
-            name, _, key = elements[index]
-            return f"absorber {name!r}" if key is not None else f"the [{name}] element"
+            name, table, key = elements[index]
+            if key is None:
+                return f"the [{name}] element"
+            return f"absorber {name!r}" if isinstance(table, Absorber) else f"the [[{table.TABLE}]] {name!r}"
 
         owner: dict[str, int] = {}  # a name -> the index of the element that uses it
         for index, (element, table, key) in enumerate(elements):
