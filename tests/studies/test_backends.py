@@ -145,13 +145,15 @@ def test_the_pool_is_kept_between_runs_and_not_after_an_early_end():
         pids = set(backend.run(_pid, range(8)))
         assert pids and os.getpid() not in pids
         assert backend._pool is not None
+        workers = set(backend._pool._processes)   # on a loaded machine one worker may have run all eight
+        assert pids <= workers
         again = set(backend.run(_pid, range(8)))
-        assert again <= pids                  # the same worker processes
+        assert again <= workers               # the same worker processes
         results = backend.run(_pid, range(8))
         next(results)
         results.close()                       # a caller that stops reading: the pool goes
         assert backend._pool is None
-        assert set(backend.run(_pid, range(4))).isdisjoint(pids)   # a new pool
+        assert set(backend.run(_pid, range(4))).isdisjoint(workers)   # a new pool
     assert backend._pool is None
 
 
