@@ -54,7 +54,7 @@ def _refresh() -> None:
     ordered = sorted(TABLES.items(), key=lambda item: (item[1].ORDER, item[0]))
     TABLES.clear()
     TABLES.update(ordered)
-    nested = {cls for other in TABLES.values() for cls in other.NESTED.values()}
+    nested = {cls for other in TABLES.values() for cls in (*other.NESTED.values(), *other.NESTED_MANY.values())}
     ELEMENT_TABLES.clear()
     ELEMENT_TABLES.update((name, cls) for name, cls in TABLES.items() if cls not in nested)
 
@@ -105,11 +105,11 @@ def register_element(table_class: type) -> type:
     if name in TABLES or name in ("conventions", "name", "version", "contact"):
         taken = TABLES.get(name, "a scene key")
         raise TypeError(f"the table name {name!r} of {table_class.__name__} is taken by {taken}")
-    for nested in table_class.NESTED.values():
+    for nested in (*table_class.NESTED.values(), *table_class.NESTED_MANY.values()):
         if nested.TABLE and TABLES.get(nested.TABLE, nested) is not nested:
             raise TypeError(f"the nested table name {nested.TABLE!r} of {table_class.__name__} is taken")
     TABLES[name] = table_class
-    for nested in table_class.NESTED.values():
+    for nested in (*table_class.NESTED.values(), *table_class.NESTED_MANY.values()):
         if nested.TABLE:
             TABLES[nested.TABLE] = nested
     _refresh()

@@ -180,7 +180,10 @@ class Cradle(Table):
         return [CradleFriction(name, name, GROUND, BARREL, force, self.friction_velocity)]
 
     def loads(self, scene, name: str) -> list[Load]:
-        """Gravity on the barrel, ``M g sin(theta)`` (none if it is 0)."""
+        """Gravity on the barrel, ``M g sin(theta)`` (none if it is 0; none on a carriage, where gravity pulls every
+        body vertically in the planar model: :mod:`mbs_models.elements.carriage`)."""
+        if getattr(scene, "carriage", None) is not None:
+            return []
         force = self.weight_along(scene.barrel.mass)
         if force == 0.0:
             return []

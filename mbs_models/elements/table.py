@@ -147,6 +147,8 @@ class Table:
     RULES: field name -> :class:`Rule` for numeric fields (``None`` values are skipped: optional fields).
     REQUIRED: keys a file must give (default: the fields without a default value).
     NESTED: field name -> Table class of a sub-table (``[absorber.contact]``).
+    NESTED_MANY: field name -> Table class of an array of sub-tables (``[[carriage.support]]``): the field holds
+        a tuple of them; dotted keys address one by its 0-based index (``carriage.support.1.stiffness``).
     ROLES: what the element is to the results (:data:`~mbs_models.elements.declaration.ABSORBER`,
         :data:`~mbs_models.elements.declaration.END_STOP`); none by default.
     OUTPUTS: the element's declared histories and metrics (:mod:`~mbs_models.elements.declaration`); none by
@@ -159,6 +161,7 @@ class Table:
     SINCE_VERSION: ClassVar[int] = 1
     RULES: ClassVar[dict[str, Rule]] = {}
     NESTED: ClassVar[dict[str, type]] = {}
+    NESTED_MANY: ClassVar[dict[str, type]] = {}
     ROLES: ClassVar[tuple[str, ...]] = ()
     OUTPUTS: ClassVar[Outputs] = NO_OUTPUTS
 
@@ -171,6 +174,14 @@ class Table:
             value = getattr(self, name)
             if value is not None and not isinstance(value, cls):
                 raise SceneError(f"{self.TABLE}.{name}", f"must be a {cls.__name__} table, got {type(value).__name__}")
+        for name, cls in self.NESTED_MANY.items():
+            value = getattr(self, name)
+            if isinstance(value, list):
+                value = tuple(value)
+                object.__setattr__(self, name, value)
+            if not isinstance(value, tuple) or not all(isinstance(item, cls) for item in value):
+                raise SceneError(f"{self.TABLE}.{name}", f"must be an array of [[{self.TABLE}.{name}]] tables "
+                                                         f"({cls.__name__}), got {type(value).__name__}")
 
     # ------------------------------------------------------------------ description
     @classmethod
@@ -203,6 +214,11 @@ class Table:
                     raise SceneError(f"{key}.{name}", f"[{key}.{name}] needs a version-{nested.SINCE_VERSION} scene "
                                                       f"(put version = {nested.SINCE_VERSION} at the top)")
                 values[name] = nested.from_mapping(values[name], f"{key}.{name}", version)
+        for name, nested in cls.NESTED_MANY.items():
+            if name in values:
+                entries = values[name] if isinstance(values[name], list) else [values[name]]
+                values[name] = tuple(nested.from_mapping(entry, f"{key}.{name}.{i}", version)
+                                     for i, entry in enumerate(entries))
         try:
             return cls(**values)
         except SceneError as exc:
@@ -215,7 +231,11 @@ class Table:
             value = getattr(self, name)
             if value is None:
                 continue
-            out[name] = value.to_mapping() if isinstance(value, Table) else value
+            if isinstance(value, Table):
+                value = value.to_mapping()
+            elif name in self.NESTED_MANY:
+                value = [item.to_mapping() for item in value]
+            out[name] = value
         return out
 
     def check_in_scene(self, scene, key: str) -> None:

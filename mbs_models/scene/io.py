@@ -204,12 +204,16 @@ def _table_lines(header: str, values: dict[str, Any], path: str) -> list[str]:
     lines = ["", header]
     nested = []
     for key, value in values.items():
-        if isinstance(value, dict):
+        if isinstance(value, dict) or (isinstance(value, list) and value and all(isinstance(v, dict) for v in value)):
             nested.append((key, value))
         else:
             lines.append(f"{key} = {_toml_value(value)}")
     for key, value in nested:
-        lines += _table_lines(f"[{path}.{key}]", value, f"{path}.{key}")
+        if isinstance(value, list):  # an array of sub-tables: [[path.key]]
+            for item in value:
+                lines += _table_lines(f"[[{path}.{key}]]", item, f"{path}.{key}")
+        else:
+            lines += _table_lines(f"[{path}.{key}]", value, f"{path}.{key}")
     return lines
 
 

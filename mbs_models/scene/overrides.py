@@ -125,10 +125,29 @@ def _field_path(table: Table, path: list[str], key: str) -> tuple[str, ...]:
         raise SceneError(key, "names a table, not a field: add the field (e.g. "
                               f"{key}.{table.field_names()[0]})")
     current = table
-    for depth, name in enumerate(path):
+    path = list(path)
+    depth = 0
+    while depth < len(path):
+        name = path[depth]
         names = type(current).field_names()
         if name not in names:
             raise SceneError(key, f"unknown key{suggestion(name, names)}")
+        many = type(current).NESTED_MANY.get(name)
+        if many is not None:  # an array of sub-tables: name.N.field
+            items = getattr(current, name)
+            if depth + 1 >= len(path) or not path[depth + 1].isdigit():
+                raise SceneError(key, f"names the array [[{name}]]: add an index and a field (e.g. "
+                                      f"{key}.0.{many.field_names()[0]})")
+            index = int(path[depth + 1])
+            if index >= len(items):
+                raise SceneError(key, f"the scene has {len(items)} [[{type(current).TABLE}.{name}]] table(s): index "
+                                      f"{index} does not exist (indices start at 0)")
+            if depth + 2 >= len(path):
+                raise SceneError(key, f"names a table, not a field: add the field (e.g. "
+                                      f"{key}.{many.field_names()[0]})")
+            current = items[index]
+            depth += 2
+            continue
         nested = type(current).NESTED.get(name)
         last = depth == len(path) - 1
         if nested is not None and last:
@@ -140,6 +159,7 @@ def _field_path(table: Table, path: list[str], key: str) -> tuple[str, ...]:
             current = getattr(current, name)
             if current is None:
                 raise SceneError(key, f"the scene has no [{name}] table to change")
+        depth += 1
     return tuple(path)
 
 
@@ -233,6 +253,11 @@ def _rebuild(table: Table, tree: dict[str, Any], keys: dict[tuple, str], at: tup
     for field, value in tree.items():
         if field in type(table).NESTED and isinstance(value, dict):
             changes[field] = _rebuild(getattr(table, field), value, keys, at + (field,))
+        elif field in type(table).NESTED_MANY and isinstance(value, dict):
+            items = list(getattr(table, field))
+            for index, subtree in value.items():
+                items[int(index)] = _rebuild(items[int(index)], subtree, keys, at + (field, index))
+            changes[field] = tuple(items)
         else:
             changes[field] = value
     law = changes.get("law")
