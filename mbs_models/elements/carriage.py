@@ -50,8 +50,11 @@ import math
 from dataclasses import dataclass
 from typing import ClassVar
 
+import numpy as np
+
 from ..errors import SceneError
-from .contact_laws import LAW_FIELDS, LAW_RULES, LawFields
+from .contact_laws import LAW_FIELDS, LAW_RULES, LawFields, law_force
+from .ops import Ops
 from .table import Rule, Table, check_number
 
 #: Default regularisation velocity of a support's Coulomb friction (m/s), as the cradle's.
@@ -109,6 +112,10 @@ class Support(LawFields, Table):
                                                    f"digit), got {self.name!r}")
         object.__setattr__(self, "position", _point(f"{self.TABLE}.position", self.position))
         super().__post_init__()
+        if self.contact_law.restitution:
+            raise SceneError(f"{self.TABLE}.law", f"law {self.law!r} needs the rate at each touch-down, which "
+                                                  f"supports do not capture yet: use hunt-crossley, hertz or "
+                                                  f"kelvin-voigt")
         anchored = self.horizontal_stiffness is not None or self.horizontal_damping is not None
         if anchored and self.friction_coefficient is not None:
             raise SceneError(f"{self.TABLE}.friction_coefficient",
@@ -218,5 +225,126 @@ def axis_point(carriage: Carriage, elevation: float, x: float) -> tuple[float, f
     return (carriage.trunnion[0] + along * math.cos(elevation), carriage.trunnion[1] + along * math.sin(elevation))
 
 
-__all__ = ["Carriage", "Support", "axis_point", "elevation_of", "gravity_of", "rotate",
-           "DEFAULT_SUPPORT_FRICTION_VELOCITY", "LAW_FIELDS"]
+
+
+# ================================================================================================ the support law
+def support_normal_force(support: Support, height, height_rate, ops: Ops):
+    """N (N, >= 0): the support's contact law at penetration ``p = -height`` (m) and rate ``p' = -height_rate``."""
+    return law_force(-height, -height_rate, support.law, support.stiffness, support.law_exponent, 0.0, ops,
+                     damping_factor=support.damping_factor if support.law == "hunt-crossley" else None,
+                     damping=support.damping or 0.0)
+
+
+def support_tangential_force(support: Support, normal, x, x_rate, anchor: float, ops: Ops):
+    """T (N, + = forward) on the carriage at the support: ``-mu N sat(u / v_reg)`` (Coulomb, regularised),
+    ``-(k_h (x - x0) + c_h u)`` while ``N > 0`` (a dug-in spade anchored at ``anchor`` = x0, m), else 0; ``x`` (m)
+    and ``x_rate`` (u, m/s) are the point's horizontal position and velocity."""
+    if support.friction > 0.0:
+        s = x_rate / support.friction_velocity
+        return -support.friction * normal * ops.select(s > 1.0, 1.0, ops.select(s < -1.0, -1.0, s))
+    if support.anchored:
+        spring = (support.horizontal_stiffness or 0.0) * (x - anchor) + (support.horizontal_damping or 0.0) * x_rate
+        return -ops.select(normal > 0.0, spring, 0.0)
+    return 0.0 * normal
+
+
+def support_stored_energy(support: Support, height, x, anchor: float, normal=None):
+    """Elastic energy (J) of a support (numpy): the normal law's ``k p^(n+1) / (n+1)`` and, for a spade,
+    ``k_h (x - x0)^2 / 2`` while ``normal > 0`` (``normal``: N at the same samples)."""
+    p = np.maximum(-np.asarray(height, dtype=float), 0.0)
+    n = support.law_exponent
+    energy = support.stiffness * p ** (n + 1.0) / (n + 1.0)
+    if support.anchored and support.horizontal_stiffness:
+        touching = np.ones_like(p, dtype=bool) if normal is None else np.asarray(normal) > 0.0
+        energy = energy + np.where(touching, 0.5 * support.horizontal_stiffness * (np.asarray(x) - anchor) ** 2, 0.0)
+    return energy
+
+
+# ================================================================================================ statics
+@dataclass(frozen=True)
+class AxisBody:
+    """A body on the recoil axis as the planar model sees it: name, mass (kg), its own inertia (kg m^2) and its
+    coordinate at t = 0 (m, rearward from battery)."""
+
+    name: str
+    mass: float
+    inertia: float = 0.0
+    position: float = 0.0
+
+
+@dataclass(frozen=True)
+class StaticState:
+    """The gun at rest on its supports: carriage frame offset ``(0, height)`` (m) and ``pitch`` (rad), each
+    support's ``loads`` (N, by name) and ``anchors`` (its static x, m: a spade's anchor)."""
+
+    height: float
+    pitch: float
+    loads: dict
+    anchors: dict
+
+
+def world_point(offset_x: float, offset_y: float, pitch: float, point) -> tuple[float, float]:
+    """``(X, Y) + R(pitch) point`` (m): a carriage-frame point in the ground frame."""
+    rx, ry = rotate(pitch, point)
+    return offset_x + rx, offset_y + ry
+
+
+def static_equilibrium(carriage: Carriage, elevation: float, gravity: float, bodies) -> StaticState:
+    """The static equilibrium of the gun on its supports (DESIGN.md "Initial state"): the axis ``bodies``
+    (:class:`AxisBody`) held at their ``position``, the carriage at ``X = 0`` (no horizontal force acts at rest:
+    friction and an unstretched spade give none) and at the height ``Y`` and pitch ``phi`` where
+
+        sum_i N_i = g (m_c + sum_j m_j),      sum_i x_i N_i = g (m_c x_c + sum_j m_j x_j)
+
+    (vertical forces and moments about the origin; ``N_i = k_i p_i^n_i`` at the penetrations ``p_i = -y_i`` of
+    the support points, ``x_i``, ``x_c``, ``x_j`` ground-frame abscissae).  Solved by Newton's method
+    (:func:`scipy.optimize.root`) from the rigid-support loads (the lever rule of the two outermost supports);
+    SceneError if no equilibrium with every load finite exists (a support carrying all the weight at a
+    penetration beyond its law, never here for positive stiffnesses)."""
+    from scipy.optimize import root
+
+    masses = [(carriage.mass, carriage.center_of_mass)]
+    masses += [(b.mass, axis_point(carriage, elevation, b.position)) for b in bodies]
+    weight = gravity * sum(m for m, _ in masses)
+    supports = carriage.supports
+
+    def residual(z):
+        height, pitch = z
+        force = moment = 0.0
+        for s in supports:
+            x, y = world_point(0.0, height, pitch, s.position)
+            load = s.stiffness * max(-y, 0.0) ** s.law_exponent
+            force += load
+            moment += x * load
+        for m, point in masses:
+            x, _ = world_point(0.0, height, pitch, point)
+            moment -= gravity * m * x
+        return [(force - weight) / max(weight, 1.0), moment / max(weight, 1.0)]
+
+    # a start: the two outermost supports carry the weight by the lever rule, at the penetration of each law
+    xs = sorted(supports, key=lambda s: s.position[0])
+    rear, front = xs[0], xs[-1]
+    x_cg = sum(m * world_point(0.0, 0.0, 0.0, p)[0] for m, p in masses) / max(sum(m for m, _ in masses), 1e-300)
+    span = front.position[0] - rear.position[0]
+    share = min(max((x_cg - rear.position[0]) / span, 0.05), 0.95)
+    p_front = front.static_penetration(weight * share)
+    p_rear = rear.static_penetration(weight * (1.0 - share))
+    pitch0 = -(p_front - p_rear) / span if share < 1 else 0.0
+    height0 = -p_rear - rear.position[1] - rear.position[0] * pitch0
+    solution = root(residual, [height0, pitch0], method="hybr", options={"xtol": 1e-14})
+    height, pitch = (float(v) for v in solution.x)
+    check = residual(solution.x)
+    if not solution.success and max(abs(check[0]), abs(check[1])) > 1e-9:
+        raise SceneError("carriage.support", f"no static equilibrium of the gun on its supports was found "
+                                             f"({solution.message})")
+    loads, anchors = {}, {}
+    for s in supports:
+        x, y = world_point(0.0, height, pitch, s.position)
+        loads[s.name] = float(s.stiffness * max(-y, 0.0) ** s.law_exponent)
+        anchors[s.name] = float(x)
+    return StaticState(height=height, pitch=pitch, loads=loads, anchors=anchors)
+
+
+__all__ = ["Carriage", "Support", "AxisBody", "StaticState", "axis_point", "elevation_of", "gravity_of", "rotate",
+           "world_point", "static_equilibrium", "support_normal_force", "support_tangential_force",
+           "support_stored_energy", "DEFAULT_SUPPORT_FRICTION_VELOCITY", "LAW_FIELDS"]

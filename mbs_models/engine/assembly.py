@@ -52,6 +52,10 @@ class Assembly:
     coordinates: body name -> index of its coordinate in the system's ODE2 coordinates.
     masses: body name -> ObjectIndex of its ``ObjectMass1D``.
     structure: :func:`structure_key` of the system (what :func:`refill` needs to match).
+    planar: the carriage's items (:class:`~mbs_models.engine.planar.PlanarItems`) of a scene with a
+        ``[carriage]``, else None.
+    columns: output name -> (sensor name, column) for outputs read from a sensor of several columns (the
+        carriage's tree node holds every coordinate: ``barrel_position`` is one column of ``tree_position``).
     """
 
     scene: Scene
@@ -68,6 +72,8 @@ class Assembly:
     coordinates: dict[str, int] = field(default_factory=dict)
     masses: dict[str, Any] = field(default_factory=dict)
     structure: tuple = ()
+    planar: Any = None
+    columns: dict[str, tuple[str, int]] = field(default_factory=dict)
 
     def close(self) -> None:
         """Release the Exudyn model (needed for symbolic user functions to be freed)."""
@@ -130,8 +136,17 @@ def assemble(scene: Scene, user_functions: str = "symbolic", mechanism: Mechanis
                         backend=user_functions)
     ground = mbs.AddNode(NodePointGround())
     assembly.markers[GROUND] = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=ground, coordinate=0))
+    planar = None
+    if scene.carriage is not None:  # the planar model: every body a coordinate of the gun's tree
+        from .planar import add_carriage
+        planar = assembly.planar = add_carriage(mbs, mechanism, user_functions)
     for element in mechanism.elements:
         for body in element.bodies:
+            if planar is not None:
+                assembly.nodes[body.name] = planar.node
+                assembly.markers[body.name] = mbs.AddMarker(MarkerNodeCoordinate(
+                    nodeNumber=planar.node, coordinate=planar.body_coordinate[body.name]))
+                continue
             node, marker, mass_object = add_body(mbs, body.mass, body.initial_velocity, body.initial_position,
                                                  with_mass_object=True)
             assembly.nodes[body.name], assembly.markers[body.name] = node, marker
@@ -150,13 +165,48 @@ def assemble(scene: Scene, user_functions: str = "symbolic", mechanism: Mechanis
                 assembly.sensors[f"{connector.name}_force"] = mbs.AddSensor(
                     SensorObject(objectNumber=index, outputVariableType=_OVT.Force, storeInternal=True))
         for load in element.loads:
+            if planar is not None:
+                from .planar import add_planar_load
+                assembly.loads[load.name] = add_planar_load(mbs, load, planar.body_markers[load.body], user_functions,
+                                                            planar.keep)
+                continue
             assembly.loads[load.name] = load.add_items(mbs, assembly.markers[load.body], user_functions)
+    if planar is not None:
+        _add_planar_sensors(assembly)
     mbs.Assemble()
     data = mbs.systemData
-    assembly.coordinates = {name: data.GetNodeLTGODE2(node)[0] for name, node in assembly.nodes.items()}
+    if planar is not None:
+        ltg = list(data.GetNodeLTGODE2(planar.node))
+        assembly.coordinates = {name: ltg[k] for name, k in planar.body_coordinate.items()}
+    else:
+        assembly.coordinates = {name: data.GetNodeLTGODE2(node)[0] for name, node in assembly.nodes.items()}
     assembly.structure = structure_key(mechanism, user_functions)
     _start_contacts(mechanism)
     return assembly
+
+
+def _add_planar_sensors(assembly: Assembly) -> None:
+    """The carriage's sensors: the tree node's coordinates, velocities and accelerations (every body's and the
+    carriage's are columns of them, :attr:`Assembly.columns`) and each support's force vector."""
+    from .planar import CARRIAGE_COORDINATES
+
+    mbs, planar = assembly.mbs, assembly.planar
+    for quantity, ovt in (("position", _OVT.Coordinates), ("velocity", _OVT.Coordinates_t),
+                          ("acceleration", _OVT.Coordinates_tt)):
+        sensor = f"tree_{quantity}"
+        assembly.sensors[sensor] = mbs.AddSensor(SensorNode(nodeNumber=planar.node, outputVariableType=ovt,
+                                                            storeInternal=True))
+        for k, name in enumerate(CARRIAGE_COORDINATES):
+            assembly.columns[f"{name}_{quantity}"] = (sensor, k)
+        for body, k in planar.body_coordinate.items():
+            assembly.columns[f"{body}_{quantity}"] = (sensor, k)
+    for support, index in planar.support_connectors.items():
+        sensor = f"support_{support}"
+        assembly.sensors[sensor] = mbs.AddSensor(SensorObject(objectNumber=index, outputVariableType=_OVT.Force,
+                                                              storeInternal=True))
+        # Exudyn's connector force f; the carriage receives -f: (T, N) = -(f_x, f_y)
+        assembly.columns[f"support_{support}_connector_x"] = (sensor, 0)
+        assembly.columns[f"support_{support}_connector_y"] = (sensor, 1)
 
 
 def _start_contacts(mechanism: Mechanism) -> None:
@@ -173,6 +223,8 @@ def refill(assembly: Assembly, scene: Scene, mechanism: Mechanism) -> Assembly:
     first assembly), no pre-step function.  Returns the new :class:`Assembly` (``assembly`` must not be used
     any more).  ValueError if the structures differ."""
     backend = assembly.backend
+    if assembly.planar is not None or scene.carriage is not None:
+        raise ValueError("a carriage scene is assembled anew for every solve")
     key = structure_key(mechanism, backend)
     if key != assembly.structure:
         raise ValueError("the scene's structure differs from the assembled system's")

@@ -303,6 +303,18 @@ def _initial_accelerations(assembly: Assembly, t: float = 0.0) -> dict[str, floa
         message = " ".join(str(exc).split())
         raise SimulationError(f"evaluating the forces at t = 0 failed: {message[:500]}") from exc
     rhs = -lhs
+    planar = assembly.planar
+    if planar is not None:  # the tree: a load pulls its body along the axis (all of the tree's coordinates)
+        from .planar import CARRIAGE_COORDINATES, load_generalized_force
+        ltg = list(data.GetNodeLTGODE2(planar.node))
+        q = np.asarray(data.GetODE2Coordinates(), dtype=float)[ltg]
+        for load in assembly.mechanism.loads:
+            rhs[ltg] += load_generalized_force(assembly.scene, q, planar.body_coordinate[load.body],
+                                               float(load.force(np.array([t]))[0]))
+        accelerations = np.linalg.solve(mass, rhs)
+        out = {body: float(accelerations[ltg[k]]) for body, k in planar.body_coordinate.items()}
+        out.update((name, float(accelerations[ltg[k]])) for k, name in enumerate(CARRIAGE_COORDINATES))
+        return out
     for load in assembly.mechanism.loads:  # external loads at t (the objects' LHS does not hold them)
         rhs[data.GetNodeLTGODE2(assembly.nodes[load.body])[0]] += float(load.force(np.array([t]))[0])
     accelerations = np.linalg.solve(mass, rhs)

@@ -8,6 +8,7 @@ Exudyn; a new one is built for every solve (contact connectors carry the onset c
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -113,6 +114,8 @@ class Mechanism:
     def last_input_time(self) -> float:
         """Time (s) after which no load or impulse adds energy: 0 for the paper's scenes, inf under a
         constant load (gravity); energy bounds hold only after it."""
+        if getattr(self.scene, "carriage", None) is not None:  # gravity pulls every body of the planar model
+            return math.inf
         last = 0.0
         for load in self.loads:
             last = max(last, load.last_input_time)

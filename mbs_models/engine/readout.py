@@ -25,6 +25,12 @@ def read_segment(assembly: Assembly, settings: SolverSettings, start_time: float
     """The sensors of the last solve: (time s, values by sensor name), duplicate time stamps dropped;
     SimulationError for NaN/inf."""
     columns = {name: _stored(assembly, name) for name in assembly.sensors}
+    if assembly.columns:  # outputs that are columns of a sensor of several (the carriage's tree node)
+        wide = {sensor for sensor, _ in assembly.columns.values()}
+        for name, (sensor, k) in assembly.columns.items():
+            columns[name] = columns[sensor][:, [0, 1 + k]]
+        for sensor in wide:
+            del columns[sensor]
     for body, value in (initial_accelerations or {}).items():
         data = columns[f"{body}_acceleration"]
         if len(data) and data[0, 0] == start_time:
@@ -56,7 +62,7 @@ def collect(assembly: Assembly, end_time: float, settings: SolverSettings,
         time, values = segments[0]
     else:
         time = np.concatenate([t for t, _ in segments])
-        values = {name: np.concatenate([v[name] for _, v in segments]) for name in assembly.sensors}
+        values = {name: np.concatenate([v[name] for _, v in segments]) for name in segments[0][1]}
     if len(time) < 2:
         raise SimulationError(f"Exudyn {settings.solver} produced fewer than two output samples")
     if abs(time[-1] - end_time) > 1e-6 * max(1.0, end_time):
@@ -66,4 +72,6 @@ def collect(assembly: Assembly, end_time: float, settings: SolverSettings,
                    velocities={b: values[f"{b}_velocity"] for b in bodies},
                    accelerations={b: values[f"{b}_acceleration"] for b in bodies},
                    forces={c.name: values[f"{c.name}_force"] for c in assembly.mechanism.connectors
-                           if c.records_force})
+                           if c.records_force},
+                   planar={name: values[name] for name in assembly.columns
+                           if not any(name == f"{b}_{q}" for b in bodies for q in ("position", "velocity", "acceleration"))})

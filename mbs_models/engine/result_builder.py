@@ -122,7 +122,7 @@ def _fields(mechanism: Mechanism, samples: Samples, metrics) -> dict:
         max_velocities=dict(metrics.max_velocity), dissipated_energy_history=energies.dissipated,
         stored_energy_histories=energies.stored, kinetic_energy_histories=energies.kinetic, element_of=element_of,
         work_histories=energies.work, element_histories=metrics.element_histories,
-        element_metrics=metrics.element_metrics)
+        element_metrics=metrics.element_metrics, carriage=metrics.carriage)
 
 
 def _check_energy_balance(record: RunRecord, fields: dict) -> None:

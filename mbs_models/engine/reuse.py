@@ -90,7 +90,7 @@ class Simulator(FreshModels):
 
     def release(self, assembly: Assembly, failed: bool) -> None:
         """Keep the system for the next scene of its structure, unless its solve raised."""
-        if failed:
+        if failed or assembly.planar is not None:  # a carriage scene is assembled anew for every solve
             assembly.close()
             return
         self._models[assembly.structure] = assembly

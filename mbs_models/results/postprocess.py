@@ -19,6 +19,7 @@ from . import element_outputs
 from .peaks import refine_maximum
 from .refinement import Episodes, refine
 from .result import ALL_METRICS, ContactOutput, Impact
+from .carriage import CarriageOutput, carriage_output
 from .samples import Interpolant, Samples
 
 
@@ -64,6 +65,7 @@ class Metrics:
     energies: Energies | None = None
     element_histories: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
     element_metrics: dict[str, dict] = field(default_factory=dict)
+    carriage: "CarriageOutput | None" = None
 
 
 def support_force_samples(mechanism, s: Samples) -> np.ndarray:
@@ -168,6 +170,8 @@ def _analyse(mechanism, s: Samples, impact_threshold: float, wanted: tuple[str, 
         metrics.peak_support_force, metrics.time_of_peak_support_force = _support_peak(
             s, metrics.support_force, k_support, refined_support)
     metrics.energies = energies(mechanism, s, interp)
+    if s.planar:  # a carriage scene: its outputs, and its energies made planar
+        metrics.carriage = carriage_output(mechanism, s, interp, metrics.energies)
     metrics.element_histories, metrics.element_metrics = element_outputs.compute(mechanism, s, interp)
     return metrics
 

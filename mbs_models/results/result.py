@@ -143,6 +143,7 @@ class Result:
     final_metrics: tuple[str, ...] = ALL_METRICS
     rest_time: float | None = None
     rest_tolerance: float | None = None
+    carriage: Any = field(repr=False, default=None)
 
     def __getattr__(self, name: str):
         """A metric an element declares, by its name (``result.shots`` of a burst): the run's one element that
@@ -343,6 +344,7 @@ class Result:
             "energy": self.energy(),
             **self._firing_metrics(),
             **self._rest_metrics(),
+            **self._carriage_metrics(),
             "steps": self.steps,
             "wall_time": self.wall_time,
         }
@@ -360,6 +362,30 @@ class Result:
         if self.work_histories:
             out["work"] = {name: float(history[-1]) for name, history in self.work_histories.items()}
         return out
+
+    def _carriage_metrics(self) -> dict[str, Any]:
+        """A carriage scene's metrics (:mod:`mbs_models.results.carriage`) and ``supports`` (a list of
+        ``{name, static_normal_force, min_normal_force, max_normal_force}``, N); nothing without a carriage."""
+        if self.carriage is None:
+            return {}
+        return {**self.carriage.metrics(), "supports": self.supports}
+
+    @property
+    def supports(self) -> list[dict[str, Any]] | None:
+        """Per support of a carriage scene: name and static, smallest and largest normal force (N); None without."""
+        if self.carriage is None:
+            return None
+        return [output.to_dict() for output in self.carriage.supports.values()]
+
+    @property
+    def carriage_position(self) -> np.ndarray | None:
+        """The carriage's CG (x, y) in m at every sample, shape (n, 2); None without a carriage."""
+        return None if self.carriage is None else self.carriage.position
+
+    @property
+    def carriage_pitch(self) -> np.ndarray | None:
+        """The carriage's pitch (rad, nose up) at every sample; None without a carriage."""
+        return None if self.carriage is None else self.carriage.pitch
 
     def _rest_metrics(self) -> dict[str, Any]:
         """``rest_time`` (s) and ``rest_tolerance`` (m and m/s) of a run stopped at rest (only then)."""

@@ -25,6 +25,9 @@ class Samples:
     velocities: dict[str, np.ndarray]
     accelerations: dict[str, np.ndarray]
     forces: dict[str, np.ndarray] = field(default_factory=dict)
+    #: A carriage scene's other histories (:mod:`mbs_models.engine.planar`): ``carriage_x_position`` ... and each
+    #: support's connector force ``support_NAME_connector_x``/``_y`` (N); empty otherwise.
+    planar: dict[str, np.ndarray] = field(default_factory=dict)
 
 
 class Interpolant:
