@@ -235,7 +235,7 @@ def support_normal_force(support: Support, height, height_rate, ops: Ops):
                      damping=support.damping or 0.0)
 
 
-def support_tangential_force(support: Support, normal, x, x_rate, anchor: float, ops: Ops):
+def support_tangential_force(support: Support, normal, x, x_rate, anchor: float, ops: Ops, height=None):
     """T (N, + = forward) on the carriage at the support: ``-mu N sat(u / v_reg)`` (Coulomb, regularised),
     ``-(k_h (x - x0) + c_h u)`` while ``N > 0`` (a dug-in spade anchored at ``anchor`` = x0, m), else 0; ``x`` (m)
     and ``x_rate`` (u, m/s) are the point's horizontal position and velocity."""
@@ -244,7 +244,7 @@ def support_tangential_force(support: Support, normal, x, x_rate, anchor: float,
         return -support.friction * normal * ops.select(s > 1.0, 1.0, ops.select(s < -1.0, -1.0, s))
     if support.anchored:
         spring = (support.horizontal_stiffness or 0.0) * (x - anchor) + (support.horizontal_damping or 0.0) * x_rate
-        return -ops.select(normal > 0.0, spring, 0.0)
+        return -ops.select(height < 0.0, spring, 0.0)
     return 0.0 * normal
 
 

@@ -127,7 +127,8 @@ def _set_support_function(mbs, index, support, anchor: float, user_functions: st
 
     def user_function(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
         normal = support_normal_force(support, displacement[1], velocity[1], ops)
-        tangential = support_tangential_force(support, normal, displacement[0], velocity[0], anchor, ops)
+        tangential = support_tangential_force(support, normal, displacement[0], velocity[0], anchor, ops,
+                                              displacement[1])
         return [-tangential, -normal, 0.0 * normal]
 
     if user_functions == "python":

@@ -203,7 +203,7 @@ def _planar_energies(mechanism, geometry, static, s, interp, q, v, supports, ene
         xn, yn = geometry.point(qn, support.position)
         un, wn = geometry.point_velocity(qn, vn, support.position)
         normal = support_normal_force(support, yn, wn, NUMPY_OPS)
-        tangential = support_tangential_force(support, normal, xn, un, anchor, NUMPY_OPS)
+        tangential = support_tangential_force(support, normal, xn, un, anchor, NUMPY_OPS, yn)
         power = -(tangential * un + normal * wn)  # into the support
         key = f"support.{support.name}"
         energies.stored[key] = stored
