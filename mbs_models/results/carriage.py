@@ -199,7 +199,7 @@ def _planar_energies(mechanism, geometry, static, s, interp, q, v, supports, ene
     for support in geometry.carriage.supports:
         anchor = static.anchors[support.name]
         x, height = geometry.point(q, support.position)
-        stored = support_stored_energy(support, height, x, anchor, supports[support.name].normal_force)
+        stored = support_stored_energy(support, height, x, anchor)
         xn, yn = geometry.point(qn, support.position)
         un, wn = geometry.point_velocity(qn, vn, support.position)
         normal = support_normal_force(support, yn, wn, NUMPY_OPS)

@@ -11,6 +11,7 @@ from ..elements.barrel import BARREL
 from ..elements.declaration import ABSORBER, END_STOP, elements_with
 from ..stop_reason import StopReason
 from . import element_outputs
+from .carriage import CARRIAGE_METRICS
 
 #: Every metric a run can report (and prove final with ``stop_when_final``).
 ALL_METRICS = ("max_barrel_displacement", "peak_contact_force", "max_absorber_velocity", "impacts",
@@ -146,11 +147,15 @@ class Result:
     carriage: Any = field(repr=False, default=None)
 
     def __getattr__(self, name: str):
-        """A metric an element declares, by its name (``result.shots`` of a burst): the run's one element that
+        """A carriage metric (``result.stability_margin``, ... :data:`~mbs_models.results.carriage.CARRIAGE_METRICS`;
+        None without a carriage), or a metric an element declares, by its name (``result.shots`` of a burst): the run's one element that
         declares it (None if none of the run's does but a registered element could; see
         :func:`~mbs_models.results.element_outputs.lookup`)."""
         if name.startswith("_") or "element_metrics" not in self.__dict__:  # (copy, pickle: before the fields)
             raise AttributeError(name)
+        if name in CARRIAGE_METRICS:  # a carriage scene's metric (None without a carriage)
+            carriage = self.__dict__.get("carriage")
+            return None if carriage is None else getattr(carriage, name)
         from .element_outputs import lookup
 
         return lookup(self, name)
