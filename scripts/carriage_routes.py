@@ -25,7 +25,8 @@ friction mu 0.3 regularised linearly below 1e-4 m/s.  Start: the statics (scipy)
 x_b = 0 with x_b' = 10 m/s (an impulse shot); 1 s.
 
 Prints: the API checks, the routes' agreement, a work-precision table against a tight solution, wall
-time per simulated second (median of 3; the load from /proc/loadavg) and the 1-D model's cost.
+time per simulated second (median of 3; the load from /proc/loadavg), the 1-D model's cost, and what limits
+DOPRI5's step in route A (route A re-run with one support parameter changed).
 Usage: ``python scripts/carriage_routes.py [--quick]``.
 """
 
@@ -560,6 +561,29 @@ def check_dopri5_with_constraints(theta, q0):
     print(f"   route B with DOPRI5: {msg}")
 
 
+def step_limiter_table(theta):
+    """What sets DOPRI5's step in route A: the wheel friction's band (a damper mu N / v_reg ~ 9e7 N s/m) or the
+    spade.  Re-runs route A with one support parameter changed (module constants, restored after)."""
+    global V_REG, MU_WHEEL, K_SPADE, C_SPADE
+    saved = (V_REG, MU_WHEEL, K_SPADE, C_SPADE)
+    print(f"what limits DOPRI5's steps (route A, {math.degrees(theta):.0f} deg, symbolic; steps at tol 1e-4 / 1e-6):")
+    cases = (("as given", {}), ("wheel v_reg 1e-3 m/s", {"V_REG": 1e-3}), ("wheel v_reg 1e-2 m/s", {"V_REG": 1e-2}),
+             ("no wheel friction", {"MU_WHEEL": 0.0}), ("spade k 5e7, c 2e5", {"K_SPADE": 5e7, "C_SPADE": 2e5}))
+    try:
+        for label, change in cases:
+            V_REG, MU_WHEEL, K_SPADE, C_SPADE = saved
+            globals().update(change)
+            q0 = statics(theta)
+            counts = []
+            for tol in (1e-4, 1e-6):
+                SC, mbs, info = build_tree(theta, q0)
+                wall, steps, ok = solve(mbs, "DOPRI5", tol=tol)
+                counts.append(f"{steps:6d} steps {wall:6.3f} s")
+            print(f"   {label:24s} " + "   ".join(counts))
+    finally:
+        V_REG, MU_WHEEL, K_SPADE, C_SPADE = saved
+
+
 # ---------------------------------------------------------------------------------------------------------
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -634,6 +658,7 @@ def main():
               + ("" if same else f" (max |dq| {np.max(np.abs(sp[1][-1] - py[1][-1])):.1e} at the end)"))
         print(f"load now: {loadavg()}")
         print()
+    step_limiter_table(math.radians(45.0))
 
 
 if __name__ == "__main__":
