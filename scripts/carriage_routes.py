@@ -45,8 +45,8 @@ from scipy.interpolate import CubicHermiteSpline
 
 import exudyn as exu
 from exudyn.advancedUtilities import CreateSymbolicUserFunction
-from exudyn.itemInterface import (LoadCoordinate, LoadMassProportional, MarkerBodyMass, MarkerBodyPosition, MarkerBodyRigid,
-                                  MarkerKinematicTreeRigid, MarkerNodeCoordinate, NodeGenericODE2,
+from exudyn.itemInterface import (LoadCoordinate, LoadMassProportional, MarkerBodyMass, MarkerBodyPosition,
+                                  MarkerBodyRigid, MarkerKinematicTreeRigid, MarkerNodeCoordinate, NodeGenericODE2,
                                   NodePointGround, NodeRigidBody2D, ObjectConnectorCartesianSpringDamper,
                                   ObjectConnectorCoordinateSpringDamper, ObjectConnectorSpringDamper,
                                   ObjectGround, ObjectJointPrismatic2D, ObjectKinematicTree, ObjectMass1D,
@@ -261,7 +261,8 @@ def build_redundant(theta, q0, backend="symbolic", v_shot=V_SHOT):
     n_c = mbs.AddNode(NodeRigidBody2D(referenceCoordinates=[CG_C[0], CG_C[1], 0.0],
                                       initialCoordinates=[q0[0], q0[1], q0[2]]))
     n_b = mbs.AddNode(NodeRigidBody2D(referenceCoordinates=[TRUNNION[0], TRUNNION[1], 0.0],
-                                      initialCoordinates=[trunnion0[0] - TRUNNION[0], trunnion0[1] - TRUNNION[1], q0[2]],
+                                      initialCoordinates=[trunnion0[0] - TRUNNION[0], trunnion0[1] - TRUNNION[1],
+                                                          q0[2]],
                                       initialVelocities=[v_b[0], v_b[1], 0.0]))
     o_c = mbs.AddObject(ObjectRigidBody2D(mass=M_C, inertia=I_C, nodeNumber=n_c))
     o_b = mbs.AddObject(ObjectRigidBody2D(mass=M_B, inertia=I_B, nodeNumber=n_b))
@@ -288,7 +289,8 @@ def build_redundant(theta, q0, backend="symbolic", v_shot=V_SHOT):
         uf, sym = cartesian_user_function(law, backend, mbs, o)
         keep.append(sym)
         mbs.SetObjectParameter(o, "springForceUserFunction", uf)
-    sensors = {name: mbs.AddSensor(SensorNode(nodeNumber=n, outputVariableType=ovt, storeInternal=True, writeToFile=False))
+    sensors = {name: mbs.AddSensor(SensorNode(nodeNumber=n, outputVariableType=ovt, storeInternal=True,
+                                              writeToFile=False))
                for name, n, ovt in (("c", n_c, OVT.Coordinates), ("cd", n_c, OVT.Coordinates_t),
                                     ("b", n_b, OVT.Coordinates), ("bd", n_b, OVT.Coordinates_t))}
     mbs.Assemble()
@@ -335,7 +337,8 @@ def build_1d(theta, backend="builtin"):
     mbs.AddObject(ObjectConnectorCoordinateSpringDamper(markerNumbers=[m_g, m_b], stiffness=K_REC, damping=C_REC,
                                                         offset=-M_B * G * math.sin(theta) / K_REC))
     mbs.AddLoad(LoadCoordinate(markerNumber=m_b, load=M_B * G * math.sin(theta)))
-    s = mbs.AddSensor(SensorNode(nodeNumber=n, outputVariableType=OVT.Coordinates, storeInternal=True, writeToFile=False))
+    s = mbs.AddSensor(SensorNode(nodeNumber=n, outputVariableType=OVT.Coordinates, storeInternal=True,
+                                 writeToFile=False))
     mbs.Assemble()
     return SC, mbs, {"keep": [], "sensors": {"q": s}}
 
@@ -429,7 +432,8 @@ def check_cartesian_sign():
         return [10.0, 20.0, 0.0]
     mbs.AddObject(ObjectConnectorCartesianSpringDamper(markerNumbers=[m0, m1], springForceUserFunction=uf))
     mbs.Assemble()
-    mbs.SolveDynamic(settings("ExplicitEuler", step=1e-3, end_time=1e-3), solverType=exu.DynamicSolverType.ExplicitEuler)
+    mbs.SolveDynamic(settings("ExplicitEuler", step=1e-3, end_time=1e-3),
+                     solverType=exu.DynamicSolverType.ExplicitEuler)
     acc = mbs.GetNodeOutput(n, OVT.Coordinates_tt)
     print("Q1 Cartesian connector: marker0 ground at (0.5, 0.5), marker1 point at (1, 2) moving (0.3, 0.4) m/s")
     print(f"   first call: d = {seen[0][1][:2]}, v = {seen[0][2][:2]}  (d = p1 - p0, v = v1 - v0)")
@@ -443,10 +447,11 @@ def check_coordinate_marker_on_tree():
     for recoil in ("builtin", "symbolic", "python"):
         SC = exu.SystemContainer()
         mbs = SC.AddSystem()
-        n = mbs.AddNode(NodeGenericODE2(referenceCoordinates=[0.0], initialCoordinates=[0.1], initialCoordinates_t=[2.0],
-                                        numberOfODE2Coordinates=1))
+        n = mbs.AddNode(NodeGenericODE2(referenceCoordinates=[0.0], initialCoordinates=[0.1],
+                                        initialCoordinates_t=[2.0], numberOfODE2Coordinates=1))
         mbs.AddObject(ObjectKinematicTree(nodeNumber=n, gravity=[0.0, -G, 0.0], jointTypes=[exu.JointType.PrismaticX],
-                                          linkParents=[-1], jointTransformations=exu.Matrix3DList([rotz3(theta + math.pi)]),
+                                          linkParents=[-1],
+                                          jointTransformations=exu.Matrix3DList([rotz3(theta + math.pi)]),
                                           jointOffsets=exu.Vector3DList([[0.0, 0.0, 0.0]]),
                                           linkInertiasCOM=exu.Matrix3DList([np.eye(3)]),
                                           linkCOMs=exu.Vector3DList([[0.0, 0.0, 0.0]]), linkMasses=[M_B]))
