@@ -2,7 +2,9 @@
 
 ``recoil run --csv FILE`` writes it (:func:`write_histories_csv`).  Columns (SI units, named
 ``"<what> [<unit>]"``): ``time [s]``; every body's position, velocity and acceleration; every contact's
-force and the force on the mount (N, positive in the recoil direction); the histories elements declare
+force and the force on the mount (N, positive in the recoil direction); on a carriage, its CG and pitch
+(``carriage x [m]``, ``carriage y [m]``, ``carriage pitch [rad]``) and each support's normal and tangential force
+(N) and height (m); the histories elements declare
 (``<element> <name> [<unit>]``, :mod:`mbs_models.elements.declaration`); the energies (J): kinetic per body,
 stored and dissipated per connector, the work of every external input, their totals and the
 energy-balance error (:meth:`Result.energy_error`).
@@ -31,6 +33,14 @@ def history_columns(result: Result) -> dict[str, np.ndarray]:
     for contact in result.contacts.values():
         columns[f"{contact.name} force [N]"] = contact.force
     columns["support force [N]"] = result.support_force
+    if result.carriage is not None:  # the planar model: the carriage and its ground reactions
+        columns["carriage x [m]"] = result.carriage.position[:, 0]
+        columns["carriage y [m]"] = result.carriage.position[:, 1]
+        columns["carriage pitch [rad]"] = result.carriage.pitch
+        for name, support in result.carriage.supports.items():
+            columns[f"{name} normal force [N]"] = support.normal_force
+            columns[f"{name} tangential force [N]"] = support.tangential_force
+            columns[f"{name} height [m]"] = support.height
     for element, _table, outputs in element_outputs.declared(result.scene):
         for history in outputs.histories:
             columns[f"{element} {history.name} [{history.unit}]"] = result.element_histories[element][history.name]

@@ -17,6 +17,7 @@ from matplotlib.figure import Figure
 from ..errors import SceneError
 from ..outputs import atomic_write_bytes
 from . import element_outputs
+from .carriage_plots import carriage_rows, plot_ground_reactions, sketch_gun
 from .result import Result
 
 #: One colour per model, used consistently in every figure.
@@ -86,9 +87,10 @@ def plot_result(result: Result, *, title: str | None = None, impact_padding: flo
     contacts = list(result.contacts.values())
     first_impact = result.impacts[0] if result.impacts else None
     declared = element_outputs.plot_panels(result)
-    rows = 3 + bool(contacts) + len(declared) + (first_impact is not None)
+    extra = carriage_rows(result)
+    rows = 3 + bool(contacts) + len(declared) + extra + (first_impact is not None)
     fig, axes = new_figure(rows, 1, row_height=2.4)
-    full = [axes[i, 0] for i in range(rows - (first_impact is not None))]
+    full = [axes[i, 0] for i in range(rows - (first_impact is not None) - (1 if extra else 0))]
     for ax in full[1:]:
         ax.sharex(full[0])
     for ax in full[:-1]:
@@ -133,6 +135,9 @@ def plot_result(result: Result, *, title: str | None = None, impact_padding: flo
             ax.plot(result.time, values, color=_series_colour(i), lw=1.0, label=name)
         ax.set_ylabel(label)
         ax.legend(fontsize=8, loc="upper right")
+    if extra:  # a carriage: its ground reactions (on the time axis) and a sketch of the gun
+        plot_ground_reactions(axes[row + 2 + len(declared), 0], result)
+        sketch_gun(axes[row + 3 + len(declared), 0], result)
     full[-1].set_xlabel("time [s]")
     if first_impact is not None:
         _plot_impact_zoom(axes[-1, 0], result, first_impact, impact_padding)

@@ -15,6 +15,8 @@ METRIC_SI_UNITS = {
     "max_barrel_displacement": "m", "peak_support_force": "N", "peak_contact_force": "N",
     "max_absorber_velocity": "m/s", "impacts": "count", "dissipated_energy": "J",
     "initial_velocity": "m/s", "end_time": "s", "steps": "count", "wall_time": "s",
+    "max_carriage_pitch": "rad", "max_lift": "m", "lift_off_time": "s", "max_carriage_displacement": "m",
+    "stability_margin": "-", "min_normal_force": "N",
 }
 
 #: Scene fields whose table gives no unit in its rules (:class:`~mbs_models.elements.table.Rule`): a

@@ -31,6 +31,7 @@ from typing import Any, Mapping, Sequence
 from ..elements.declaration import ABSORBER, END_STOP, elements_with
 from ..engine.accuracy import SolverSettings
 from ..results import element_outputs
+from ..results.carriage import CARRIAGE_METRICS
 from ..scene import Scene
 from ..scene.overrides import apply_overrides
 
@@ -101,6 +102,9 @@ def metric_columns(scene: Scene) -> list[str]:
         columns += [f"absorber.{i}.{m}" for i in range(len(absorbers)) for m in ABSORBER_METRICS]
     columns += [f"{stop}.{m}" for stop in _stops(scene) for m in STOP_METRICS]
     columns += element_outputs.sweep_columns(scene)  # the metrics elements declare (``<element>.<name>``)
+    if getattr(scene, "carriage", None) is not None:  # the planar model: stability and each support's least load
+        columns += list(CARRIAGE_METRICS)
+        columns += [f"support.{s.name}.min_normal_force" for s in scene.carriage.supports]
     return columns + list(RUN_COLUMNS)
 
 
@@ -121,6 +125,10 @@ def result_row(result, scene: Scene) -> dict[str, Any]:
         row[f"{stop}.impacts"] = None if impacts is None else len(impacts)
         row[f"{stop}.dissipated_energy"] = entry.get("dissipated_energy")
     row.update(element_outputs.sweep_row(result))
+    if result.carriage is not None:
+        row.update(result.carriage.metrics())
+        row.update((f"support.{name}.min_normal_force", output.min_normal_force)
+                   for name, output in result.carriage.supports.items())
     row.update(initial_velocity=scene.initial_velocity, end_time=result.end_time,
                stop_reason=str(result.stop_reason), steps=result.steps)  # the StopReason's text: tables hold strings
     return row
