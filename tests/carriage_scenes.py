@@ -40,7 +40,10 @@ def carriage_scene(changes: dict | None = None, **tables):
         parts = key.split(".")
         for part in parts[:-1]:
             node = node[int(part)] if isinstance(node, list) else node[part]
-        node[parts[-1]] = value
+        if value is None:
+            node.pop(parts[-1], None)
+        else:
+            node[parts[-1]] = value
     return scene_from_dict(data)
 
 

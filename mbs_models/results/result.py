@@ -392,6 +392,22 @@ class Result:
         """The carriage's pitch (rad, nose up) at every sample; None without a carriage."""
         return None if self.carriage is None else self.carriage.pitch
 
+    def _carriage_lines(self) -> list[str]:
+        """The summary's lines of a carriage scene: the verdict, the stability margin, each support's loads."""
+        carriage = self.carriage
+        if carriage is None:
+            return []
+        verdict = ("stays on the ground" if carriage.lift_off_time is None else
+                   f"a support leaves the ground at {carriage.lift_off_time:.5f} s (lift {carriage.max_lift * 1e3:.3f} mm)")
+        lines = [f"  carriage                 {verdict}",
+                 f"  stability margin         {carriage.stability_margin:.4f} (least support load / its static load)",
+                 f"  carriage pitch, shift    {carriage.max_carriage_pitch * 1e3:.4f} mrad, "
+                 f"{carriage.max_carriage_displacement * 1e3:.4f} mm"]
+        for name, support in carriage.supports.items():
+            lines.append(f"  {name:24s} {support.static_normal_force / 1e3:.3f} kN static, "
+                         f"{support.min_normal_force / 1e3:.3f} to {support.max_normal_force / 1e3:.3f} kN")
+        return lines
+
     def _rest_metrics(self) -> dict[str, Any]:
         """``rest_time`` (s) and ``rest_tolerance`` (m and m/s) of a run stopped at rest (only then)."""
         if self.rest_time is None:
@@ -456,6 +472,7 @@ class Result:
         if "pulse_impulse" in firing:
             lines.append(f"  breech pulse impulse     {firing['pulse_impulse']:.1f} N s per shot")
         lines += element_outputs.summary_lines(self)
+        lines += self._carriage_lines()
         supplied = self.kinetic_energy_history[0] + self.stored_energy_history[0] + sum(firing.get("work", {}).values())
         lines.append(f"  energy dissipated        {self.total_dissipated_energy:.2f} J of "
                      f"{supplied:.2f} J" + (" (with the work of the inputs)" if "work" in firing else ""))
