@@ -34,7 +34,7 @@ its point ``P(r_s)`` with height ``y_s`` and horizontal velocity ``u_s``, is
     N   = law(p, p'),  p = -y_s                           (>= 0; the contact law of the table)
     T   = -mu N sat(u_s / v_reg)                           (Coulomb, regularised: sat clips to [-1, 1])
     T   = -(k_h (x_s - x_s0) + c_h u_s)   while p > 0     (a dug-in spade; x_s0 its static x), else 0
-          (times min(p / p_e, 1) with an engagement depth p_e > 0: the grip grows with the depth)
+          (x_s0: where it last touched down, with anchor = "touchdown")
 
 Gravity ``g`` (the ``[cradle]`` value, 9.81 without it) pulls every body vertically.  The gun starts at rest
 in the static equilibrium of the whole gun on its supports with the axis bodies held where the 1-D model starts
@@ -56,10 +56,12 @@ import numpy as np
 from ..errors import SceneError
 from .contact_laws import LAW_FIELDS, LAW_RULES, LawFields, law_force
 from .ops import Ops
-from .table import Rule, Table, check_number
+from .table import Rule, Table, check_choice, check_number
 
 #: Default regularisation velocity of a support's Coulomb friction (m/s), as the cradle's.
 DEFAULT_SUPPORT_FRICTION_VELOCITY = 1.0e-4
+#: Where a spade's horizontal anchor sits: its static x for good, or where it last touched the ground.
+ANCHORS = ("rest", "touchdown")
 #: Default gravitational acceleration (m/s^2) of a carriage scene without a ``[cradle]`` table.
 DEFAULT_GRAVITY = 9.81
 
@@ -85,9 +87,8 @@ class Support(LawFields, Table):
     horizontal_stiffness, horizontal_damping: k_h (N/m), c_h (N s/m) of a dug-in spade anchored at the point's
         static x while its normal force is > 0.  Not both; neither: frictionless.
     friction_velocity: v_reg (m/s, > 0; default 1e-4): the friction is ``mu N u / v_reg`` below it.
-    engagement_depth: p_e (m, >= 0; default 0) of a spade: its anchor's force grows linearly with the penetration
-        up to p_e, ``min(p / p_e, 1)``; 0: all of it as soon as the point touches (DESIGN.md; a spade pulled out
-        while holding a horizontal load can then switch its anchor on and off at every step).
+    anchor: where a spade's anchor is: ``"rest"`` (default, DESIGN.md: its static x, for good) or ``"touchdown"``
+        (where it last touched the ground: after a jump the spade digs in where it lands).
     """
 
     name: str
@@ -103,14 +104,13 @@ class Support(LawFields, Table):
     friction_velocity: float = DEFAULT_SUPPORT_FRICTION_VELOCITY
     horizontal_stiffness: float | None = None
     horizontal_damping: float | None = None
-    engagement_depth: float = 0.0
+    anchor: str = "rest"
     TABLE: ClassVar[str] = "support"
     SINCE_VERSION: ClassVar[int] = 2
     RULES: ClassVar = {**LAW_RULES, "friction_coefficient": Rule(0.0),
                        "friction_velocity": Rule(0.0, strict=True, unit="m/s"),
                        "horizontal_stiffness": Rule(0.0, unit="N/m"),
-                       "horizontal_damping": Rule(0.0, unit="N s/m"),
-                       "engagement_depth": Rule(0.0, unit="m")}
+                       "horizontal_damping": Rule(0.0, unit="N s/m")}
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name.isidentifier():
@@ -118,9 +118,10 @@ class Support(LawFields, Table):
                                                    f"digit), got {self.name!r}")
         object.__setattr__(self, "position", _point(f"{self.TABLE}.position", self.position))
         super().__post_init__()
-        if self.engagement_depth and not (self.horizontal_stiffness or self.horizontal_damping):
-            raise SceneError(f"{self.TABLE}.engagement_depth", "is a spade's (it scales the horizontal anchor): give "
-                                                               "horizontal_stiffness or horizontal_damping, or drop it")
+        check_choice(f"{self.TABLE}.anchor", self.anchor, ANCHORS, "anchor")
+        if self.anchor != "rest" and not (self.horizontal_stiffness or self.horizontal_damping):
+            raise SceneError(f"{self.TABLE}.anchor", "is a spade's (it places the horizontal anchor): give "
+                                                     "horizontal_stiffness or horizontal_damping, or drop it")
         if self.contact_law.restitution:
             raise SceneError(f"{self.TABLE}.law", f"law {self.law!r} needs the rate at each touch-down, which "
                                                   f"supports do not capture yet: use hunt-crossley, hertz or "
@@ -246,31 +247,54 @@ def support_normal_force(support: Support, height, height_rate, ops: Ops):
 
 def support_tangential_force(support: Support, normal, x, x_rate, anchor: float, ops: Ops, height=None):
     """T (N, + = forward) on the carriage at the support: ``-mu N sat(u / v_reg)`` (Coulomb, regularised),
-    ``-(k_h (x - x0) + c_h u)`` while ``p = -height > 0`` (a dug-in spade anchored at ``anchor`` = x0, m; times
-    ``min(p / p_e, 1)`` with an ``engagement_depth`` p_e > 0), else 0; ``x`` (m) and ``x_rate`` (u, m/s) are the
+    ``-(k_h (x - x0) + c_h u)`` while ``p = -height > 0`` (a dug-in spade anchored at ``anchor`` = x0, m), else 0; ``x`` (m) and ``x_rate`` (u, m/s) are the
     point's horizontal position and velocity, ``height`` (m) its y."""
     if support.friction > 0.0:
         s = x_rate / support.friction_velocity
         return -support.friction * normal * ops.select(s > 1.0, 1.0, ops.select(s < -1.0, -1.0, s))
     if support.anchored:
         spring = (support.horizontal_stiffness or 0.0) * (x - anchor) + (support.horizontal_damping or 0.0) * x_rate
-        if support.engagement_depth > 0.0:  # the grip grows with the depth: min(p / p_e, 1), p = -height
-            grip = -height / support.engagement_depth
-            return -spring * ops.select(grip > 1.0, 1.0, ops.select(grip < 0.0, 0.0, grip))
         return -ops.select(height < 0.0, spring, 0.0)
     return 0.0 * normal
 
 
 def support_stored_energy(support: Support, height, x, anchor: float):
-    """Elastic energy (J) of a support (numpy): the normal law's ``k p^(n+1) / (n+1)`` and, for a spade without an
-    engagement depth, ``k_h (x - x0)^2 / 2`` while ``p > 0``.  (With an engagement depth the anchor's force is no
-    potential's: its work is booked as dissipated, with its sign.)"""
+    """Elastic energy (J) of a support (numpy): the normal law's ``k p^(n+1) / (n+1)`` and, for a spade,
+    ``k_h (x - x0)^2 / 2`` while ``p > 0`` (``anchor`` = x0: a number, or an array at the samples)."""
     p = np.maximum(-np.asarray(height, dtype=float), 0.0)
     n = support.law_exponent
     energy = support.stiffness * p ** (n + 1.0) / (n + 1.0)
-    if support.anchored and support.horizontal_stiffness and support.engagement_depth == 0.0:
+    if support.anchored and support.horizontal_stiffness:
         energy = energy + np.where(p > 0.0, 0.5 * support.horizontal_stiffness * (np.asarray(x) - anchor) ** 2, 0.0)
     return energy
+
+
+class AnchorCapture:
+    """A ``touchdown`` spade's anchor (m), captured at the step starts of a solve: while the point is off the
+    ground (``height >= 0``) the anchor follows its x, so that it stays where the point last touched down (to
+    within the point's horizontal travel in the step that lands).  :attr:`history` holds ``(time, anchor)`` at
+    every change, for the forces between and at the samples (:meth:`anchor_at`)."""
+
+    def __init__(self, anchor: float):
+        self.anchor = float(anchor)
+        self.history: list[tuple[float, float]] = [(0.0, self.anchor)]
+        self._variable = None  # the symbolic variable, if any
+
+    def observe(self, t: float, x: float, height: float) -> None:
+        """The point's x (m) and height (m) at the step start ``t`` (s)."""
+        if height < 0.0 or x == self.anchor:
+            return
+        self.anchor = float(x)
+        self.history.append((float(t), self.anchor))
+        if self._variable is not None:
+            self._variable.SetValue(self.anchor)
+
+    def anchor_at(self, t) -> np.ndarray:
+        """The anchor (m) in force at times ``t`` (s): the value set at the last step start before t."""
+        times = np.array([h[0] for h in self.history])
+        values = np.array([h[1] for h in self.history])
+        index = np.clip(np.searchsorted(times, np.asarray(t, dtype=float), side="left") - 1, 0, len(values) - 1)
+        return values[index]
 
 
 # ================================================================================================ statics
@@ -358,6 +382,6 @@ def static_equilibrium(carriage: Carriage, elevation: float, gravity: float, bod
     return StaticState(height=height, pitch=pitch, loads=loads, anchors=anchors)
 
 
-__all__ = ["Carriage", "Support", "AxisBody", "StaticState", "axis_point", "elevation_of", "gravity_of", "rotate",
+__all__ = ["Carriage", "Support", "AxisBody", "AnchorCapture", "ANCHORS", "StaticState", "axis_point", "elevation_of", "gravity_of", "rotate",
            "world_point", "static_equilibrium", "support_normal_force", "support_tangential_force",
            "support_stored_energy", "DEFAULT_SUPPORT_FRICTION_VELOCITY", "LAW_FIELDS"]

@@ -26,7 +26,7 @@ class Ops:
 
     ``maximum(a, b)``, ``power(a, x)``, ``choose(condition, value_if_true, value_if_false)`` (values are
     numbers), ``select(condition, a, b)`` (values may be expressions of the backend), ``absolute(a)``,
-    ``tanh(a)``, ``log(a)``; ``name``: ``"python"``, ``"symbolic"`` or ``"numpy"``.
+    ``tanh(a)``, ``log(a)``, ``sin(a)``, ``cos(a)``; ``name``: ``"python"``, ``"symbolic"`` or ``"numpy"``.
     """
 
     maximum: Callable[[Any, Any], Any]
@@ -37,6 +37,8 @@ class Ops:
     absolute: Callable[[Any], Any] = None
     tanh: Callable[[Any], Any] = None
     log: Callable[[Any], Any] = None
+    sin: Callable[[Any], Any] = None
+    cos: Callable[[Any], Any] = None
 
 
 def _py_choose(condition, a, b):
@@ -44,9 +46,9 @@ def _py_choose(condition, a, b):
 
 
 PYTHON_OPS = Ops(maximum=max, power=math.pow, choose=_py_choose, name="python", select=_py_choose, absolute=abs,
-                 tanh=math.tanh, log=math.log)
+                 tanh=math.tanh, log=math.log, sin=math.sin, cos=math.cos)
 NUMPY_OPS = Ops(maximum=np.maximum, power=np.power, choose=np.where, name="numpy", select=np.where,
-                absolute=np.abs, tanh=np.tanh, log=np.log)
+                absolute=np.abs, tanh=np.tanh, log=np.log, sin=np.sin, cos=np.cos)
 
 
 def symbolic_ops() -> Ops:
@@ -63,7 +65,7 @@ def symbolic_ops() -> Ops:
         return esym.IfThenElse(condition, wrap(a), wrap(b))
 
     return Ops(maximum=esym.max, power=esym.pow, choose=choose, name="symbolic", select=select,
-               absolute=esym.abs, tanh=esym.tanh, log=esym.log)
+               absolute=esym.abs, tanh=esym.tanh, log=esym.log, sin=esym.sin, cos=esym.cos)
 
 
 def piecewise_linear(x, points, ops: Ops):

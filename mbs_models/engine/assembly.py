@@ -164,12 +164,9 @@ def assemble(scene: Scene, user_functions: str = "symbolic", mechanism: Mechanis
             if connector.records_force:
                 assembly.sensors[f"{connector.name}_force"] = mbs.AddSensor(
                     SensorObject(objectNumber=index, outputVariableType=_OVT.Force, storeInternal=True))
+        if planar is not None:  # a carriage scene: its loads act through the tree's force user function
+            continue
         for load in element.loads:
-            if planar is not None:
-                from .planar import add_planar_load
-                assembly.loads[load.name] = add_planar_load(mbs, load, planar.body_markers[load.body], user_functions,
-                                                            planar.keep)
-                continue
             assembly.loads[load.name] = load.add_items(mbs, assembly.markers[load.body], user_functions)
     if planar is not None:
         _add_planar_sensors(assembly)
@@ -187,7 +184,8 @@ def assemble(scene: Scene, user_functions: str = "symbolic", mechanism: Mechanis
 
 def _add_planar_sensors(assembly: Assembly) -> None:
     """The carriage's sensors: the tree node's coordinates, velocities and accelerations (every body's and the
-    carriage's are columns of them, :attr:`Assembly.columns`) and each support's force vector."""
+    carriage's are columns of them, :attr:`Assembly.columns`); the supports' forces are their law at these states
+    (:mod:`mbs_models.results.carriage`)."""
     from .planar import CARRIAGE_COORDINATES
 
     mbs, planar = assembly.mbs, assembly.planar
@@ -200,13 +198,6 @@ def _add_planar_sensors(assembly: Assembly) -> None:
             assembly.columns[f"{name}_{quantity}"] = (sensor, k)
         for body, k in planar.body_coordinate.items():
             assembly.columns[f"{body}_{quantity}"] = (sensor, k)
-    for support, index in planar.support_connectors.items():
-        sensor = f"support_{support}"
-        assembly.sensors[sensor] = mbs.AddSensor(SensorObject(objectNumber=index, outputVariableType=_OVT.Force,
-                                                              storeInternal=True))
-        # Exudyn's connector force f; the carriage receives -f: (T, N) = -(f_x, f_y)
-        assembly.columns[f"support_{support}_connector_x"] = (sensor, 0)
-        assembly.columns[f"support_{support}_connector_y"] = (sensor, 1)
 
 
 def _start_contacts(mechanism: Mechanism) -> None:

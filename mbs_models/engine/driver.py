@@ -146,6 +146,9 @@ def _pre_step_function(assembly: Assembly, budget: StepBudget | None, tracker: F
         ib = None if contact.b == "ground" else assembly.coordinates[contact.b]
         captures.append((contact.capture, ia, ib))
     observe = tracker.observe if tracker is not None else None
+    planar = assembly.planar if assembly.planar is not None and assembly.planar.anchors else None
+    if planar is not None:  # the carriage's touchdown anchors see the tree's state at every step start
+        tree = list(data.GetNodeLTGODE2(planar.node))
     steps = 0  # calls so far (all segments of a run): the budget's step count and the tracker's cadence
     next_check = budget.next_check if budget is not None else math.inf
     solver = []  # Exudyn's time-integration state, cached on the first call of each solve
@@ -167,6 +170,12 @@ def _pre_step_function(assembly: Assembly, budget: StepBudget | None, tracker: F
                 raise _BudgetSpent(f"step budget spent at t = {t:.6g} s")
             next_check = budget.next_check
         q = v = None
+        if planar is not None:
+            q = read_positions(copy=False).tolist()
+            v = read_velocities(copy=False).tolist()
+            if not solver:
+                solver.append(mbs.sys["dynamicSolver"].it)
+            planar.observe(t - solver[0].currentStepSize, [q[i] for i in tree], [v[i] for i in tree])
         if captures:
             q = read_positions(copy=False).tolist()
             v = read_velocities(copy=False).tolist()
@@ -186,7 +195,7 @@ def _pre_step_function(assembly: Assembly, budget: StepBudget | None, tracker: F
             return not observe(t, q, v)
         return not observe(t, [q[i] for i in order], [v[i] for i in order])
 
-    function = count if budget is not None and not captures and observe is None else pre_step
+    function = count if budget is not None and not captures and observe is None and planar is None else pre_step
     function.new_solve = solver.clear  # a segmented run calls it before each segment's solve
     return function
 
@@ -215,7 +224,8 @@ def _solve(assembly: Assembly, settings: SolverSettings, end_time: float,
         run["budget"] = None
         if settings.adaptive:  # every adaptive solve: bounded steps and stored samples (engine/guard.py)
             run["budget"] = StepBudget.for_run(run.get("end_time", end_time), len(assembly.sensors))
-        if run["budget"] is not None or tracker is not None or assembly.mechanism.capturing_contacts:
+        anchors = assembly.planar is not None and assembly.planar.anchors
+        if run["budget"] is not None or tracker is not None or assembly.mechanism.capturing_contacts or anchors:
             run["pre_step"] = _pre_step_function(assembly, run["budget"], tracker)
             mbs.SetPreStepUserFunction(run["pre_step"])
     elif "pre_step" in run:
@@ -284,6 +294,8 @@ def _initial_accelerations(assembly: Assembly, t: float = 0.0) -> dict[str, floa
     dissipated energy and refined extrema there -- needs the true value.  Call before solving.
     """
     mbs, data = assembly.mbs, assembly.mbs.systemData
+    if assembly.planar is not None:
+        data.SetTime(t)  # the tree's force user function depends on time (a breech pulse)
     lhs = np.zeros(data.ODE2Size())
     mass = np.zeros((data.ODE2Size(), data.ODE2Size()))
     try:
@@ -304,13 +316,9 @@ def _initial_accelerations(assembly: Assembly, t: float = 0.0) -> dict[str, floa
         raise SimulationError(f"evaluating the forces at t = 0 failed: {message[:500]}") from exc
     rhs = -lhs
     planar = assembly.planar
-    if planar is not None:  # the tree: a load pulls its body along the axis (all of the tree's coordinates)
-        from .planar import CARRIAGE_COORDINATES, load_generalized_force
+    if planar is not None:  # the tree's force user function (supports, loads) is in its LHS, evaluated at t
+        from .planar import CARRIAGE_COORDINATES
         ltg = list(data.GetNodeLTGODE2(planar.node))
-        q = np.asarray(data.GetODE2Coordinates(), dtype=float)[ltg]
-        for load in assembly.mechanism.loads:
-            rhs[ltg] += load_generalized_force(assembly.scene, q, planar.body_coordinate[load.body],
-                                               float(load.force(np.array([t]))[0]))
         accelerations = np.linalg.solve(mass, rhs)
         out = {body: float(accelerations[ltg[k]]) for body, k in planar.body_coordinate.items()}
         out.update((name, float(accelerations[ltg[k]])) for k, name in enumerate(CARRIAGE_COORDINATES))

@@ -19,11 +19,15 @@ tree's equations.  Gravity is the tree's ``gravity`` (every link, vertically).  
 breech force) is a ``LoadForceVector`` along the body's local x on a ``MarkerKinematicTreeRigid`` of its link:
 a force on that body alone, not on the carriage.
 
-Each support is an ``ObjectConnectorCartesianSpringDamper`` between a ground marker at the origin and a
-``MarkerKinematicTreeRigid`` of the carriage link at the support point, whose spring-force user function (its
-displacement is the point's position, its velocity the point's velocity) returns ``-(T, N, 0)``: Exudyn applies
-``-f`` to the second marker, so the carriage receives ``(T, N)`` with the support law of
-:mod:`mbs_models.elements.carriage` (written once over the backend ops, as every law).
+The supports and the external loads act through the tree's force user function (:func:`generalized_forces`, one
+function over the backend ops, recorded once as an Exudyn symbolic function): a support at the carriage-frame
+point ``r`` is at ``P = (X, Y) + R(phi) r`` with ``dP/dphi = R'(phi) r``; its force ``(T, N)`` (the support law of
+:mod:`mbs_models.elements.carriage`) adds ``(T, N, (T, N) . dP/dphi)`` to ``(Q_X, Q_Y, Q_phi)``.  A load ``F(t)``
+pulling body ``i`` rearward along the axis, ``f = F (-R(phi) e)`` at its CG ``r_i = (X, Y) + R(phi) a_i``, adds
+``f . dr_i/dq``: ``(f, f . R'(phi) a_i)`` to the carriage's and ``F`` to ``Q_i`` (``dr_i/dx_i = -R e``).
+(Measured, Exudyn 1.13.6: a ``CartesianSpringDamper`` on a ``MarkerKinematicTreeRigid`` per support cost ~17 us
+per step each; the tree's force user function with both supports ~8 us in all: ``scripts/carriage_routes.py``,
+``scripts/bench_carriage.py``.)
 """
 
 from __future__ import annotations
@@ -34,9 +38,9 @@ from typing import Any
 
 import numpy as np
 
-from ..elements.carriage import (AxisBody, StaticState, elevation_of, gravity_of, static_equilibrium,
+from ..elements.carriage import (AnchorCapture, AxisBody, StaticState, elevation_of, gravity_of, static_equilibrium,
                                  support_normal_force, support_tangential_force)
-from ..elements.ops import ops_for
+from ..elements.ops import PYTHON_OPS, Ops, ops_for
 
 #: Tree coordinates before the axis bodies: X, Y, phi.
 CARRIAGE_COORDINATES = ("carriage_x", "carriage_y", "carriage_pitch")
@@ -44,17 +48,29 @@ CARRIAGE_COORDINATES = ("carriage_x", "carriage_y", "carriage_pitch")
 
 @dataclass
 class PlanarItems:
-    """What :func:`add_carriage` added: the tree node and object, each body's coordinate index in the node, each
-    support's connector, the rigid markers of the bodies (for loads), the static state and the user functions
-    (kept alive as long as the system)."""
+    """What :func:`add_carriage` added: the tree node and object, each body's coordinate index in the node, the
+    static state and the user function (kept alive as long as the system)."""
 
     node: Any
     tree: Any
     static: StaticState
     body_coordinate: dict[str, int]
-    support_connectors: dict[str, Any] = field(default_factory=dict)
-    body_markers: dict[str, Any] = field(default_factory=dict)
     keep: list = field(default_factory=list)
+    #: support name -> its :class:`~mbs_models.elements.carriage.AnchorCapture` (``anchor = "touchdown"`` spades)
+    anchors: dict = field(default_factory=dict)
+    #: support name -> its carriage-frame point (m), for the captures
+    anchor_points: dict = field(default_factory=dict)
+
+    def observe(self, t: float, q, v) -> None:
+        """The tree's state (``q``, ``v``: its coordinates in order) at the step start ``t``: the touchdown anchors
+        follow their points while off the ground."""
+        if not self.anchors:
+            return
+        X, Y, phi = q[0], q[1], q[2]
+        c, s = math.cos(phi), math.sin(phi)
+        for support, capture in self.anchors.items():
+            rx, ry = self.anchor_points[support]
+            capture.observe(t, X + c * rx - s * ry, Y + s * rx + c * ry)
 
 
 def axis_bodies(mechanism) -> list[AxisBody]:
@@ -69,13 +85,43 @@ def _rotation_z(angle: float) -> np.ndarray:
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
+def generalized_forces(scene, supports, anchors: dict, loads, q, q_t, t, ops: Ops) -> list:
+    """The ``supports``' and the loads' generalised forces ``[Q_X, Q_Y, Q_phi, Q_1 .. Q_n]`` (N, N, N m, N ...) at
+    the tree state ``q``, ``q_t`` and time ``t`` (s), over ``ops`` (module docstring).  ``anchors``: each support's
+    static x (m); ``loads``: ``(tree coordinate, law)`` pairs, ``law(t)`` the force (N, + = rearward) over ``ops``."""
+    carriage, theta = scene.carriage, elevation_of(scene)
+    X, Y, phi = q[0], q[1], q[2]
+    c, s = ops.cos(phi), ops.sin(phi)
+    zero = 0.0 * X
+    out = [zero] * len(q)
+    for support in supports:
+        rx, ry = support.position
+        dx, dy = -s * rx - c * ry, c * rx - s * ry           # dP/dphi
+        x, y = X + c * rx - s * ry, Y + s * rx + c * ry
+        u, v = q_t[0] + q_t[2] * dx, q_t[1] + q_t[2] * dy
+        normal = support_normal_force(support, y, v, ops)
+        tangential = support_tangential_force(support, normal, x, u, anchors[support.name], ops, y)
+        out[0], out[1] = out[0] + tangential, out[1] + normal
+        out[2] = out[2] + tangential * dx + normal * dy
+    ex, ey = math.cos(theta), math.sin(theta)
+    for k, law in loads:
+        force = law(t)
+        along = carriage.barrel_center_of_mass - q[k]
+        ax, ay = carriage.trunnion[0] + along * ex, carriage.trunnion[1] + along * ey
+        fx, fy = -force * (c * ex - s * ey), -force * (s * ex + c * ey)
+        out[0], out[1] = out[0] + fx, out[1] + fy
+        out[2] = out[2] + fx * (-s * ax - c * ay) + fy * (c * ax - s * ay)
+        out[k] = out[k] + force
+    return out
+
+
 def add_carriage(mbs, mechanism, user_functions: str) -> PlanarItems:
-    """Add the gun's tree, its supports and its loads' items to ``mbs`` (module docstring); the tree starts in the
-    static equilibrium (:func:`~mbs_models.elements.carriage.static_equilibrium`) with the axis bodies at their
-    initial positions and velocities."""
+    """Add the gun's tree (with its supports and its bodies' loads in the tree's force user function) to ``mbs``
+    (module docstring); the tree starts in the static equilibrium
+    (:func:`~mbs_models.elements.carriage.static_equilibrium`) with the axis bodies at their initial positions and
+    velocities."""
     import exudyn
-    from exudyn.itemInterface import (MarkerBodyPosition, MarkerKinematicTreeRigid, NodeGenericODE2, ObjectGround,
-                                      ObjectKinematicTree, ObjectConnectorCartesianSpringDamper)
+    from exudyn.itemInterface import NodeGenericODE2, ObjectKinematicTree
 
     scene = mechanism.scene
     carriage = scene.carriage
@@ -105,76 +151,66 @@ def add_carriage(mbs, mechanism, user_functions: str) -> PlanarItems:
         gravity=[0.0, -g, 0.0]))
     items = PlanarItems(node=node, tree=tree, static=static,
                         body_coordinate={b.name: 3 + i for i, b in enumerate(bodies)})
-    ground = mbs.AddObject(ObjectGround())
-    origin = mbs.AddMarker(MarkerBodyPosition(bodyNumber=ground, localPosition=[0.0, 0.0, 0.0]))
     for support in carriage.supports:
-        point = mbs.AddMarker(MarkerKinematicTreeRigid(objectNumber=tree, linkNumber=2,
-                                                       localPosition=[*support.position, 0.0]))
-        index = mbs.AddObject(ObjectConnectorCartesianSpringDamper(markerNumbers=[origin, point],
-                                                                   ))
-        _set_support_function(mbs, index, support, static.anchors[support.name], user_functions, items.keep)
-        items.support_connectors[support.name] = index
-    for i, body in enumerate(bodies):
-        items.body_markers[body.name] = mbs.AddMarker(MarkerKinematicTreeRigid(objectNumber=tree, linkNumber=3 + i,
-                                                                               localPosition=[0.0, 0.0, 0.0]))
+        if support.anchored and support.anchor == "touchdown":
+            items.anchors[support.name] = AnchorCapture(static.anchors[support.name])
+            items.anchor_points[support.name] = support.position
+    _set_tree_forces(mbs, items, mechanism, user_functions, n)
     return items
 
 
-def _set_support_function(mbs, index, support, anchor: float, user_functions: str, keep: list) -> None:
-    """The support's law as the connector's spring-force user function: ``-(T, N, 0)`` from the point's position
-    (``displacement``) and velocity."""
+def _set_tree_forces(mbs, items: PlanarItems, mechanism, user_functions: str, n: int) -> None:
+    """:func:`generalized_forces` as the tree's force user function (Python, or recorded as a symbolic function
+    with state vectors of the tree's size: Exudyn's own conversion records them empty)."""
     ops = ops_for(user_functions)
+    loads = [(items.body_coordinate[load.body], load.user_function_law(ops)) for load in mechanism.loads]
+    scene, anchors = mechanism.scene, dict(items.static.anchors)
+    captures = items.anchors
+    if user_functions == "symbolic" and captures:  # the touchdown anchors: variables the pre-step function sets
+        import exudyn
+        for name, capture in captures.items():
+            capture._variable = exudyn.symbolic.Real(f"anchor_{name}_{id(capture)}", capture.anchor)
+            anchors[name] = capture._variable
+        captures = {}
 
-    def user_function(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
-        normal = support_normal_force(support, displacement[1], velocity[1], ops)
-        tangential = support_tangential_force(support, normal, displacement[0], velocity[0], anchor, ops,
-                                              displacement[1])
-        return [-tangential, -normal, 0.0 * normal]
+    def user_function(mbs, t, itemNumber, q, q_t):
+        for name, capture in captures.items():  # (Python: read at every call)
+            anchors[name] = capture.anchor
+        return generalized_forces(scene, scene.carriage.supports, anchors, loads, q, q_t, t, ops)
 
     if user_functions == "python":
         function = user_function
     else:
-        from exudyn.advancedUtilities import CreateSymbolicUserFunction
-        function = CreateSymbolicUserFunction(mbs, user_function, "springForceUserFunction", index)
-    keep.append(function)
-    mbs.SetObjectParameter(index, "springForceUserFunction", function)
+        function = _symbolic_vector_function(mbs, user_function, "ObjectKinematicTree", "forceUserFunction",
+                                             items.tree, n)
+    items.keep.append(function)
+    mbs.SetObjectParameter(items.tree, "forceUserFunction", function)
 
 
-def add_planar_load(mbs, load, marker, user_functions: str, keep: list):
-    """A body's external load (N, + = rearward along the axis) as a ``LoadForceVector`` along the body's local x
-    (``bodyFixed``) on its rigid marker: a force on that body alone; returns the LoadIndex."""
-    from exudyn.itemInterface import LoadForceVector
+def _symbolic_vector_function(mbs, function, item_type: str, name: str, index, size: int):
+    """``function`` recorded as an Exudyn symbolic user function whose vector arguments have ``size`` entries."""
+    import exudyn
+    from exudyn.itemInterface import userFunctionArgsDict
 
-    index = mbs.AddLoad(LoadForceVector(markerNumber=marker, loadVector=[load.constant, 0.0, 0.0], bodyFixed=True))
-    if load.needs_user_function:
-        law = load.user_function_law(ops_for(user_functions))
-
-        def user_function(mbs, t, vector):
-            return [law(t), 0.0, 0.0]
-
-        if user_functions == "python":
-            function = user_function
+    esym = exudyn.symbolic
+    types, _, returned = userFunctionArgsDict[f"{item_type},{name}"][:3]
+    names = function.__code__.co_varnames[:len(types)]
+    arguments = []
+    for kind, argument in zip(types, names):
+        if kind == "MainSystem":
+            arguments.append(mbs)
+        elif kind in ("Real", "Index"):
+            arguments.append(esym.Real(argument, 0.0))
         else:
-            from exudyn.advancedUtilities import CreateSymbolicUserFunction
-            function = CreateSymbolicUserFunction(mbs, user_function, "loadVectorUserFunction", index)
-        keep.append(function)
-        mbs.SetLoadParameter(index, "loadVectorUserFunction", function)
-    return index
-
-
-def load_generalized_force(scene, q: np.ndarray, coordinate: int, force: float) -> np.ndarray:
-    """The generalised force (N, N, N m, N, ...) of ``force`` (N) pulling the axis body of tree coordinate
-    ``coordinate`` rearward along the axis, at the tree state ``q``: ``Q = J^T f`` with ``f = -force R(phi) e``
-    at the body's CG ``r = (X, Y) + R(phi) a``, ``a = trunnion + (b - x) e``."""
-    carriage, theta = scene.carriage, elevation_of(scene)
-    phi, x = q[2], q[coordinate]
-    e = np.array([math.cos(theta), math.sin(theta)])
-    a = np.array(carriage.trunnion) + (carriage.barrel_center_of_mass - x) * e
-    c, s = math.cos(phi), math.sin(phi)
-    rotation = np.array([[c, -s], [s, c]])
-    f = -force * (rotation @ e)
-    d_phi = np.array([[-s, -c], [c, -s]]) @ a
-    out = np.zeros(len(q))
-    out[0], out[1], out[2] = f[0], f[1], float(f @ d_phi)
-    out[coordinate] = float(f @ (-(rotation @ e)))
-    return out
+            arguments.append(esym.Vector(argument, [0.0] * size))
+    recording = esym.GetRecording()
+    esym.SetRecording(True)
+    try:
+        value = esym.Vector(function(*arguments))
+    finally:
+        esym.SetRecording(recording)
+    symbolic = esym.UserFunction()
+    symbolic.SetUserFunctionFromDict(mbs, {"functionName": function.__name__, "argList": arguments,
+                                           "argTypeList": list(types), "returnValue": value,
+                                           "returnType": returned[0]}, name, index, "None")
+    return symbolic

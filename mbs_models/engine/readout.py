@@ -68,10 +68,14 @@ def collect(assembly: Assembly, end_time: float, settings: SolverSettings,
     if abs(time[-1] - end_time) > 1e-6 * max(1.0, end_time):
         raise SimulationError(f"Exudyn {settings.solver} output ends at t = {time[-1]:.6g} s, not at {end_time:g} s")
     bodies = [body.name for body in assembly.mechanism.bodies]
+    planar = {name: values[name] for name in assembly.columns
+              if not any(name == f"{b}_{q}" for b in bodies for q in ("position", "velocity", "acceleration"))}
+    if assembly.planar is not None:  # the touchdown anchors in force at the samples
+        for support, capture in assembly.planar.anchors.items():
+            planar[f"support_{support}_anchor"] = capture.anchor_at(time)
     return Samples(time=time, positions={b: values[f"{b}_position"] for b in bodies},
                    velocities={b: values[f"{b}_velocity"] for b in bodies},
                    accelerations={b: values[f"{b}_acceleration"] for b in bodies},
                    forces={c.name: values[f"{c.name}_force"] for c in assembly.mechanism.connectors
                            if c.records_force},
-                   planar={name: values[name] for name in assembly.columns
-                           if not any(name == f"{b}_{q}" for b in bodies for q in ("position", "velocity", "acceleration"))})
+                   planar=planar)

@@ -1,7 +1,8 @@
 """What a carriage scene's solve means: the carriage's motion, the ground reactions, stability, planar energies.
 
-From the samples of the gun's tree (:mod:`mbs_models.engine.planar`: ``q = (X, Y, phi, x_1 .. x_n)`` and each
-support's connector force), with the geometry of :mod:`mbs_models.elements.carriage`:
+From the samples of the gun's tree (:mod:`mbs_models.engine.planar`: ``q = (X, Y, phi, x_1 .. x_n)`` and their
+rates), with the geometry and the support law of :mod:`mbs_models.elements.carriage` (the same law the solver
+applied, evaluated at the samples' states):
 
 * ``carriage_position`` (CG x, y, m) ``= (X, Y) + R(phi) c`` and ``carriage_pitch`` ``phi`` (rad);
 * per support: ``normal_force`` N (N, >= 0), ``tangential_force`` T (N, + = forward, on the carriage) and
@@ -154,10 +155,13 @@ def carriage_output(mechanism, s: Samples, interp: Interpolant, energies=None) -
     static_cg = geometry.point({"carriage_x": 0.0, "carriage_y": static.height, "carriage_pitch": static.pitch},
                                carriage.center_of_mass)
     supports = {}
-    for support in carriage.supports:
-        normal = -s.planar[f"support_{support.name}_connector_y"]
-        tangential = -s.planar[f"support_{support.name}_connector_x"]
-        _, height = geometry.point(q, support.position)
+    for support in carriage.supports:  # the law at the samples' states: the forces the solver applied there
+        x, height = geometry.point(q, support.position)
+        u, w = geometry.point_velocity(q, v, support.position)
+        normal = np.asarray(support_normal_force(support, height, w, NUMPY_OPS), dtype=float)
+        anchor = s.planar.get(f"support_{support.name}_anchor", static.anchors[support.name])
+        tangential = np.asarray(support_tangential_force(support, normal, x, u, anchor, NUMPY_OPS, height),
+                                dtype=float) + 0.0 * normal
         load = static.loads[support.name]
         supports[support.name] = SupportOutput(support.name, normal, tangential, np.asarray(height),
                                                static_normal_force=load, min_normal_force=float(np.min(normal)),
@@ -197,13 +201,14 @@ def _planar_energies(mechanism, geometry, static, s, interp, q, v, supports, ene
     potential = _potential(geometry, q, zero_v)
     energies.stored["gravity"] = potential - potential[0]
     for support in geometry.carriage.supports:
-        anchor = static.anchors[support.name]
+        anchor = s.planar.get(f"support_{support.name}_anchor", static.anchors[support.name])
         x, height = geometry.point(q, support.position)
         stored = support_stored_energy(support, height, x, anchor)
         xn, yn = geometry.point(qn, support.position)
         un, wn = geometry.point_velocity(qn, vn, support.position)
         normal = support_normal_force(support, yn, wn, NUMPY_OPS)
-        tangential = support_tangential_force(support, normal, xn, un, anchor, NUMPY_OPS, yn)
+        anchor_n = anchor if np.ndim(anchor) == 0 else np.asarray(anchor)[1:]  # the step's: set at its start
+        tangential = support_tangential_force(support, normal, xn, un, anchor_n, NUMPY_OPS, yn)
         power = -(tangential * un + normal * wn)  # into the support
         key = f"support.{support.name}"
         energies.stored[key] = stored

@@ -29,7 +29,8 @@ from carriage_scenes import BASE, carriage_scene
     ({"carriage.mass": 0.0}, "carriage.mass", "> 0"),
     ({"carriage.inertia": -1.0}, "carriage.inertia", "> 0"),
     ({"carriage.trunnion": "high"}, "carriage.trunnion", "point"),
-    ({"carriage.support.1.engagement_depth": 1e-3}, "carriage.support.1.engagement_depth", "spade"),
+    ({"carriage.support.1.anchor": "touchdown"}, "carriage.support.1.anchor", "spade"),
+    ({"carriage.support.0.anchor": "dug"}, "carriage.support.0.anchor", "unknown anchor"),
     ({"carriage.support.0.horizontal_stiffness": -1.0}, "carriage.support.0.horizontal_stiffness", ">= 0"),
 ])
 def test_bad_carriage_tables_name_the_key(changes, key, words):
