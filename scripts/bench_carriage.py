@@ -8,7 +8,12 @@ For each carriage scene, its 1-D twin is the same scene without ``[carriage]`` (
 gravity acts along the axis on the barrel: DESIGN.md).  Both are run ``repeats`` times, interleaved, in this
 process (``simulate`` at each accuracy preset); the ratio of the median wall times of complete runs (and of the
 solves alone) is the planar model's cost per simulated second (issue #22's target: at most 3x at ``standard``).
-Absolute times are printed in brackets only.  :func:`carriage_costs` is also section 8 of ``scripts/bench.py``.
+Absolute times are printed in brackets only.
+
+Beside it, Exudyn's floor (:func:`bare_floor`): per fixed DOPRI5 step, a bare ``ObjectKinematicTree`` of the planar
+model's links (prismatic X, prismatic Y, revolute pitch, one prismatic axis link; linear coordinate springs, no
+user function, no sensor) against a bare 1-D ``ObjectMass1D`` with one linear spring: what the tree costs
+Exudyn before the product adds anything.  With the carriage's extra steps it bounds the ratio from below.
 """
 
 from __future__ import annotations
@@ -59,6 +64,60 @@ def carriage_costs(names=SCENES, end_time: float = 10.0, repeats: int = 5, prese
     return rows
 
 
+def _bare_step_cost(tree: bool, steps: int = 20000) -> float:
+    """us per fixed DOPRI5 step of a bare tree (``tree``) or a bare 1-D mass (module docstring)."""
+    import math
+    import time
+
+    import exudyn
+    import numpy as np
+    from exudyn.itemInterface import (MarkerNodeCoordinate, NodeGenericODE2, NodePointGround,
+                                      ObjectConnectorCoordinateSpringDamper, ObjectKinematicTree, ObjectMass1D)
+
+    container = exudyn.SystemContainer()
+    mbs = container.AddSystem()
+    n = 4 if tree else 1
+    node = mbs.AddNode(NodeGenericODE2(referenceCoordinates=[0.0] * n, initialCoordinates=[0.0] * n,
+                                       initialCoordinates_t=[0.0] * (n - 1) + [1.0], numberOfODE2Coordinates=n))
+    if tree:
+        joint = exudyn.JointType
+        turn = np.array([[-1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0]])
+        mbs.AddObject(ObjectKinematicTree(
+            nodeNumber=node, jointTypes=[joint.PrismaticX, joint.PrismaticY, joint.RevoluteZ, joint.PrismaticX],
+            linkParents=[-1, 0, 1, 2], jointTransformations=exudyn.Matrix3DList([np.eye(3)] * 3 + [turn]),
+            jointOffsets=exudyn.Vector3DList([[0.0, 0.0, 0.0]] * 3 + [[2.5, 1.0, 0.0]]),
+            linkInertiasCOM=exudyn.Matrix3DList([np.zeros((3, 3))] * 2 + [np.eye(3) * 1500.0, np.eye(3)]),
+            linkCOMs=exudyn.Vector3DList([[0.0, 0.0, 0.0]] * 2 + [[2.4, 0.8, 0.0], [0.0, 0.0, 0.0]]),
+            linkMasses=[0.0, 0.0, 2000.0, 1000.0], gravity=[0.0, 0.0, 0.0]))
+    else:
+        mbs.AddObject(ObjectMass1D(nodeNumber=node, mass=1000.0))
+    ground = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=mbs.AddNode(NodePointGround()), coordinate=0))
+    for k in range(n):
+        marker = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=node, coordinate=k))
+        mbs.AddObject(ObjectConnectorCoordinateSpringDamper(markerNumbers=[ground, marker], stiffness=27500.0,
+                                                            damping=6239.0))
+    mbs.Assemble()
+    settings = exudyn.SimulationSettings()
+    settings.timeIntegration.endTime = 1.0
+    settings.timeIntegration.numberOfSteps = steps
+    settings.timeIntegration.verboseMode = 0
+    settings.solutionSettings.writeSolutionToFile = False
+    started = time.perf_counter()
+    mbs.SolveDynamic(settings, solverType=exudyn.DynamicSolverType.DOPRI5)
+    cost = (time.perf_counter() - started) / steps * 1e6
+    container.Reset()
+    return cost if math.isfinite(cost) else float("nan")
+
+
+def bare_floor(repeats: int = 5) -> tuple[float, float]:
+    """Median us per step: (bare tree, bare 1-D mass)."""
+    trees, masses = [], []
+    for _ in range(repeats):
+        trees.append(_bare_step_cost(True))
+        masses.append(_bare_step_cost(False))
+    return statistics.median(trees), statistics.median(masses)
+
+
 def print_costs(rows: list[dict], end_time: float) -> None:
     print(f"carriage scene / its 1-D twin, {end_time:g} s simulated (medians; same process, interleaved)")
     for row in rows:
@@ -82,6 +141,15 @@ def main(argv=None) -> int:
         load = handle.read().split()[0]
     print(f"(machine load {load})")
     print_costs(rows, args.end_time)
+    tree, mass = bare_floor()
+    print(f"Exudyn's floor per fixed DOPRI5 step: a bare tree of the planar links {tree / mass:5.1f}x a bare 1-D mass "
+          f"[{tree:.1f} / {mass:.1f} us]")
+    for row in rows:
+        if row["preset"] == "standard":
+            per_step_1d = row["1-D"][1] / row["1-D"][2] * 1e6
+            print(f"   {row['scene']}: the bare tree alone per step is {tree / per_step_1d:4.2f}x the 1-D product's "
+                  f"whole step [{per_step_1d:.1f} us]; times the {row['step_ratio']:.2f}x steps: at least "
+                  f"{tree / per_step_1d * row['step_ratio']:4.1f}x per simulated second")
     return 0
 
 

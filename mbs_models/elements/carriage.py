@@ -56,7 +56,7 @@ import numpy as np
 from ..errors import SceneError
 from .contact_laws import LAW_FIELDS, LAW_RULES, LawFields, law_force
 from .ops import Ops
-from .table import Rule, Table, check_choice, check_number
+from .table import Rule, Table, check_choice, check_derived, check_number, ieee_power
 
 #: Default regularisation velocity of a support's Coulomb friction (m/s), as the cradle's.
 DEFAULT_SUPPORT_FRICTION_VELOCITY = 1.0e-4
@@ -201,6 +201,38 @@ class Carriage(Table):
     def supports(self) -> tuple[Support, ...]:
         """The supports, in the file's order."""
         return self.support
+
+    #: The carriage's mass over the recoiling masses, and its inertia over ``m_c L^2`` (``L``: the largest distance
+    #: of a support or the trunnion from its CG), must lie within these bounds: beyond them the gun's mass matrix
+    #: is singular to double precision (a unit slip, never a carriage).
+    MASS_RATIO = (1e-9, 1e12)
+
+    def check_in_scene(self, scene, key: str) -> None:
+        """Gravity > 0 (the supports carry the gun's weight); the weight and each support's static penetration
+        representable; the carriage's mass and inertia within :attr:`MASS_RATIO` of the recoiling parts'."""
+        gravity = gravity_of(scene)
+        if not gravity > 0.0:
+            raise SceneError("cradle.gravity", f"must be > 0 m/s^2 on a carriage (the supports carry the gun's "
+                                               f"weight), got {gravity:g}")
+        axis = scene.barrel.mass + sum(a.mass for a in scene.absorbers)
+        keys = {f"{key}.mass": self.mass, "barrel.mass": scene.barrel.mass, "cradle.gravity": gravity}
+        weight = check_derived(keys, "the gun's weight g (m_c + sum m)", gravity * (self.mass + axis), "N",
+                               positive=True)
+        low, high = self.MASS_RATIO
+        if not low <= self.mass / axis <= high:
+            raise SceneError(f"{key}.mass", f"must be within [{low:g}, {high:g}] times the recoiling mass "
+                                            f"({axis:g} kg), got {self.mass:g} kg")
+        points = [s.position for s in self.support] + [self.trunnion]
+        arm = max(max(math.dist(p, self.center_of_mass) for p in points), 1e-3)
+        if not low <= self.inertia / (self.mass * arm ** 2) <= high:
+            raise SceneError(f"{key}.inertia", f"must be within [{low:g}, {high:g}] times m_c L^2 = "
+                                               f"{self.mass * arm ** 2:g} kg m^2 (L = {arm:g} m, the largest "
+                                               f"distance of a support or the trunnion from the CG), got "
+                                               f"{self.inertia:g}")
+        for i, s in enumerate(self.support):
+            check_derived({f"{key}.support.{i}.stiffness": s.stiffness, f"{key}.mass": self.mass},
+                          "the support's penetration under the whole weight (W / k)^(1/n)",
+                          ieee_power(weight / s.stiffness, 1.0 / s.law_exponent), "m")
 
     # ------------------------------------------------------------------ the element
     def bodies(self, scene, name: str) -> list:
@@ -350,7 +382,7 @@ def static_equilibrium(carriage: Carriage, elevation: float, gravity: float, bod
         force = moment = 0.0
         for s in supports:
             x, y = world_point(0.0, height, pitch, s.position)
-            load = s.stiffness * max(-y, 0.0) ** s.law_exponent
+            load = s.stiffness * ieee_power(max(-y, 0.0), s.law_exponent)
             force += load
             moment += x * load
         for m, point in masses:
@@ -368,12 +400,14 @@ def static_equilibrium(carriage: Carriage, elevation: float, gravity: float, bod
     p_rear = rear.static_penetration(weight * (1.0 - share))
     pitch0 = -(p_front - p_rear) / span if share < 1 else 0.0
     height0 = -p_rear - rear.position[1] - rear.position[0] * pitch0
-    solution = root(residual, [height0, pitch0], method="hybr", options={"xtol": 1e-14})
-    height, pitch = (float(v) for v in solution.x)
-    check = residual(solution.x)
-    if not solution.success and max(abs(check[0]), abs(check[1])) > 1e-9:
+    with np.errstate(all="ignore"):
+        solution = root(residual, [height0, pitch0], method="hybr", options={"xtol": 1e-14})
+        height, pitch = (float(v) for v in solution.x)
+        check = residual(solution.x)
+    if not (math.isfinite(height) and math.isfinite(pitch) and all(math.isfinite(c) for c in check)) or \
+            (not solution.success and max(abs(check[0]), abs(check[1])) > 1e-9):
         raise SceneError("carriage.support", f"no static equilibrium of the gun on its supports was found "
-                                             f"({solution.message})")
+                                             f"({' '.join(str(solution.message).split())})")
     loads, anchors = {}, {}
     for s in supports:
         x, y = world_point(0.0, height, pitch, s.position)

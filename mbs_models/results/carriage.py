@@ -29,6 +29,7 @@ import numpy as np
 from ..elements.carriage import (AxisBody, StaticState, elevation_of, gravity_of, static_equilibrium,
                                  support_normal_force, support_stored_energy, support_tangential_force)
 from ..elements.ops import NUMPY_OPS
+from ..errors import SimulationError
 from .energies import _GL_NODES, cumulative_quadrature
 from .samples import Interpolant, Samples
 
@@ -172,8 +173,13 @@ def carriage_output(mechanism, s: Samples, interp: Interpolant, energies=None) -
         off = np.flatnonzero((output.normal_force <= 0.0) & (t > 0.0))
         if len(off):
             lift_off = float(t[off[0]]) if lift_off is None else min(lift_off, float(t[off[0]]))
-    margin = min(o.min_normal_force / o.static_normal_force if o.static_normal_force > 0 else math.inf
-                 for o in supports.values())
+    with np.errstate(all="ignore"):
+        margin = min(o.min_normal_force / o.static_normal_force if o.static_normal_force > 0 else math.inf
+                     for o in supports.values())
+    if not math.isfinite(margin):
+        loads = ", ".join(f"{o.name} {o.static_normal_force:.3g} N" for o in supports.values())
+        raise SimulationError(f"the stability margin (least load / static load) is beyond double precision: the "
+                              f"static loads ({loads}) are too small against the loads of the run")
     heights = np.concatenate([o.height for o in supports.values()])
     output = CarriageOutput(position=cg, pitch=np.asarray(q["carriage_pitch"]), static_pitch=static.pitch,
                             supports=supports,

@@ -84,6 +84,9 @@ def version_2_tables(data: dict) -> list[tuple[str, str]]:
                 # a version-1 absorber's contact is the top-level [contact]; the nested one is version 2's
                 if name in entry and (nested.SINCE_VERSION > 1 or cls.MANY):
                     found.append((f"{table}.{name}", f"[{table}.{name}]"))
+            for name in cls.NESTED_MANY:
+                if name in entry:
+                    found.append((f"{table}.{name}", f"[[{table}.{name}]]"))
     return list(dict.fromkeys(found))
 
 
