@@ -127,6 +127,18 @@ def _cmd_precision(args) -> int:
     out = prepare_output_dir(args.out)
     start = time.perf_counter()
     progress = _progress()
+    if scene.carriage is not None:  # the planar model: its own study against the planar reference
+        from validation.studies.carriage_precision import carriage_study
+
+        if args.presets:
+            raise SceneError("--presets", "runs the presets on the 19 paper cases: not with a carriage scene")
+        study = carriage_study(scene, end_time=args.end_time, repeats=args.repeats, quick=args.quick,
+                               progress=progress)
+        study.write(out)
+        print(study.summary_markdown())
+        print(f"wrote carriage_precision.md, .csv, .json and work_precision_carriage.png to {out} in "
+              f"{time.perf_counter() - start:.1f} s")
+        return EXIT_OK
     study = run_study(scene, end_time=args.end_time, repeats=args.repeats, quick=args.quick, progress=progress)
     study.write(out)
     print(study.summary_markdown().split("\n## All settings")[0])
