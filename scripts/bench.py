@@ -33,6 +33,8 @@ What it measures (not a timed test: the numbers depend on the machine; the ratio
    2); on a 2-worker Dask ``LocalCluster``; and, in this process, a fresh ``simulate`` per point against one
    reused :class:`~mbs_models.Simulator` (and, with the memory test, RSS over 10 000 reused points).
 7. **The whole-paper job**: wall time of a full ``recoil paper`` before issue #11 and now (``--paper``).
+8. **The planar model** (issue #22, :mod:`bench_carriage`): each shipped carriage scene against the same hardware
+   without ``[carriage]``, per simulated second, and Exudyn's floor (a bare tree against a bare 1-D mass, per step).
 
 It ends with issue #11's targets, each ratio beside its target.  Absolute times are printed only in
 brackets beside the ratios, for context.
@@ -270,6 +272,8 @@ def main(argv=None) -> int:
     parser.add_argument("--skip-memory", action="store_true")
     parser.add_argument("--skip-elements", action="store_true", help="skip the absorber-count and onset-capture costs")
     parser.add_argument("--skip-sweeps", action="store_true", help="skip the Figs 4/5 sweep throughput")
+    parser.add_argument("--skip-carriage", action="store_true",
+                        help="skip the carriage scenes against their 1-D twins (section 8)")
     parser.add_argument("--gap-count", type=int, default=121,
                         help="gaps of the Figs 4/5 sweep per model and mass (default 121: 726 points)")
     parser.add_argument("--sweep-rounds", type=int, default=3,
@@ -554,6 +558,16 @@ def main(argv=None) -> int:
     print("\nissue #11's targets (ratios of this run; the machine's load affects the wall-time ones)")
     for name, value, target, met in rows:
         print(f"   {name:55s} {value:7.2f}   target {target:8s} {'met' if met else 'NOT met'}")
+    if not args.skip_carriage:
+        import bench_carriage
+
+        say("the carriage scenes against their 1-D twins")
+        print("\n8. the planar model (issue #22): ", end="")
+        bench_carriage.print_costs(bench_carriage.carriage_costs(end_time=end_time, repeats=max(3, args.repeats // 3)),
+                                   end_time)
+        tree, mass = bench_carriage.bare_floor()
+        print(f"   Exudyn's floor per fixed DOPRI5 step: a bare tree of the planar links {tree / mass:5.1f}x a bare "
+              f"1-D mass [{tree:.1f} / {mass:.1f} us] (scripts/bench_carriage.py: the floor per simulated second)")
     return 0
 
 
