@@ -139,12 +139,20 @@ def solve_reference(scene, end_time: float = 10.0, *, method: str = "DOP853", rt
         closed form without, 2e-10 with; the late, weak impacts of model (i), m = 500 kg, gap 0 have
         peaks 2.8e-7 off a rtol = 1e-13 run without, 1.5e-8 with.
 
+    A scene with ``[carriage]`` is solved by the planar model (:func:`validation.reference.planar.solve_planar`,
+    a :class:`~validation.reference.planar.PlanarResult`).
+
     Raises
     ------
     ReferenceSolveError: solver failure, non-finite state, or chattering (too many segments).
     ReferenceModelError: a scene table the reference has no term for.
     ValueError: a bad argument (names it).
     """
+    if getattr(scene, "carriage", None) is not None:  # the gun on its carriage: the planar model
+        from .planar import solve_planar
+        return solve_planar(scene, end_time, method=method, rtol=rtol, atol=atol, impact_threshold=impact_threshold,
+                            max_step=max_step, max_segments=max_segments, stop_when_final=stop_when_final,
+                            refine_releases=refine_releases)
     _check_args(scene, end_time, method, rtol, atol, impact_threshold, max_step, max_segments)
     requested = check_names(stop_when_final)
     model = build_model(scene)
