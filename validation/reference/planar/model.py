@@ -149,20 +149,18 @@ class PlanarModel:
         arrays for a batch.  ``omit``: leave out axis connector ``omit`` (its force, or its constraint);
         ``free_support``: leave out that support's normal force (and what follows from it)."""
         y = np.asarray(y, dtype=float)
-        single = y.ndim == 1
-        Y = y[:, None] if single else y
-        N = Y.shape[1]
-        tt = np.broadcast_to(np.asarray(0.0 if t is None else t, dtype=float), (N,))
+        batch = y.ndim == 2
+        shape = y.shape[1:]                                       # () for a state, (N,) for a batch
         g = self.geometry
         nb = self.axis.n_bodies
         axis_mode = mode.axis_mode() if isinstance(mode, PlanarMode) else mode
-        function = self.axis.compiled(axis_mode, "axis_array", omit)
-        forces, f, fg, powers = function(Y[:self.n1])
-        forces = [np.broadcast_to(np.asarray(F, dtype=float), (N,)).copy() for F in forces]
-        fg = np.broadcast_to(np.asarray(fg, dtype=float), (N,)).copy()
-        X, Yc, phi, dX, dY, dphi = self.carriage(Y)
-        xs, vs = self.axis_coordinates(Y)
-        qd = np.stack([dX, dY, dphi] + list(vs))
+        function = self.axis.compiled(axis_mode, "axis_array" if batch else "axis", omit)
+        forces, f, fg, powers = function(y[:self.n1])
+        if batch:
+            forces = [np.broadcast_to(np.asarray(F, dtype=float), shape).copy() for F in forces]
+            fg = np.broadcast_to(np.asarray(fg, dtype=float), shape).copy()
+        X, Yc, phi, dX, dY, dphi = self.carriage(y)
+        xs, vs = self.axis_coordinates(y)
         Q = g.gravity_forces(phi, xs) - g.velocity_terms(phi, xs, dphi, vs)
         for i in range(nb):
             Q[3 + i] += f[i]
@@ -170,6 +168,8 @@ class PlanarModel:
         if self.axis.loads:
             if t is None:
                 raise ValueError("the model has loads: evaluate needs the time t")
+            qd = np.stack([dX + 0.0 * phi, dY + 0.0 * phi, dphi + 0.0 * phi] + [v + 0.0 * phi for v in vs])
+            tt = np.broadcast_to(np.asarray(t, dtype=float), shape) if batch else float(t)
             for load, L in zip(self.axis.loads, self.load_values(axis_mode, tt)):
                 QL = g.axis_load(phi, xs, L, self.axis.body_index[load.body])
                 Q += QL
@@ -188,39 +188,47 @@ class PlanarModel:
             normal.append(Nn)
             tangential.append(T)
             support_powers.append(s.dissipated_power(smode, -y_s, -w_s, Nn, T, u_s, x_s))
-        M = np.moveaxis(g.mass_matrix(phi, xs), -1, 0)            # (N, n, n)
-        rhs = np.moveaxis(Q, -1, 0)[..., None]                     # (N, n, 1)
+        M = g.mass_matrix(phi, xs)
+        if batch:
+            M, Q = np.moveaxis(M, -1, 0), np.moveaxis(Q, -1, 0)   # (N, n, n), (N, n)
         held = [j for j in self.constraints(axis_mode) if j != omit]
         if not held:
-            qdd = np.linalg.solve(M, rhs)[..., 0].T
+            qdd = np.linalg.solve(M, Q[..., None])[..., 0]
         else:
-            G = np.zeros((len(Q), len(held)))
+            G = np.zeros((g.n, len(held)))
             for col, j in enumerate(held):
                 c = self.axis.connectors[j]
                 if c.body_a is not None:
                     G[3 + c.body_a, col] += 1.0
                 if c.body_b is not None:
                     G[3 + c.body_b, col] -= 1.0
-            MG = np.linalg.solve(M, np.broadcast_to(G, (N,) + G.shape))  # (N, n, k)
-            MQ = np.linalg.solve(M, rhs)                                 # (N, n, 1)
-            K = np.einsum("ik,nil->nkl", G, MG)
-            lam = -np.linalg.solve(K, np.einsum("ik,nil->nkl", G, MQ))   # (N, k, 1)
-            qdd = (MQ + MG @ lam)[..., 0].T
+            MG = np.linalg.solve(M, np.broadcast_to(G, M.shape[:-2] + G.shape))  # (..., n, k)
+            MQ = np.linalg.solve(M, Q[..., None])                               # (..., n, 1)
+            K = G.T @ MG                                                        # (..., k, k)
+            lam = -np.linalg.solve(K, G.T @ MQ)                                 # (..., k, 1)
+            qdd = (MQ + MG @ lam)[..., 0]
             for col, j in enumerate(held):
                 c = self.axis.connectors[j]
-                F = lam[:, col, 0]
+                F = lam[..., col, 0] if batch else float(lam[col, 0])
                 forces[j] = F
                 fg = fg + c.support_sign * F
-                d, rate = c.d_of(Y), c.rate_of(Y)
-                static = np.array([c.static_force(float(v)) for v in np.broadcast_to(d, (N,))])
+                d, rate = c.d_of(y), c.rate_of(y)
+                static = (np.array([c.static_force(float(v)) for v in np.ravel(d)]).reshape(np.shape(d)) if batch
+                          else c.static_force(float(d)))
                 if c.dissipates:
-                    k = self.axis.dissipating.index(c)
-                    powers[k] = (F - static) * rate
-        out = PlanarEvaluation(forces, [qdd[3 + i] for i in range(nb)], fg, qdd=qdd, normal=normal,
-                               tangential=tangential, support_powers=support_powers,
-                               powers=[np.broadcast_to(np.asarray(P, dtype=float), (N,)) for P in powers],
-                               work_rates=work_rates)
-        return _first(out) if single else out
+                    powers[self.axis.dissipating.index(c)] = (F - static) * rate
+        if batch:
+            qdd = qdd.T
+            powers = [np.broadcast_to(np.asarray(P, dtype=float), shape) for P in powers]
+            normal, tangential, support_powers = ([np.broadcast_to(np.asarray(v, dtype=float), shape) for v in group]
+                                                  for group in (normal, tangential, support_powers))
+        else:
+            fg = float(fg)
+            normal, tangential, support_powers, powers, work_rates = (
+                [float(v) for v in group] for group in (normal, tangential, support_powers, powers, work_rates))
+        return PlanarEvaluation(forces, [qdd[3 + i] for i in range(nb)], fg, qdd=qdd, normal=normal,
+                                tangential=tangential, support_powers=support_powers, powers=powers,
+                                work_rates=work_rates)
 
     def rhs(self, mode: PlanarMode):
         """``f(t, y) -> dy/dt`` in ``mode`` (state layout: module docstring)."""
@@ -233,7 +241,10 @@ class PlanarModel:
         works = [axis.work_slot[load.name] for load in axis.loads]
 
         def function(t, y):
-            ev = self.evaluate(mode, y, t=t)
+            try:
+                ev = self.evaluate(mode, y, t=t)
+            except OverflowError:  # a rejected trial state (as the 1-D right-hand side: inf, as numpy gives)
+                return np.full(self.n_states, np.inf)
             out = np.zeros(self.n_states)
             for i in range(nb):
                 out[2 * i] = y[2 * i + 1]
@@ -293,14 +304,3 @@ class PlanarModel:
         """Kinetic + stored (connectors and supports) + gravity potential (J)."""
         return (sum(self.kinetic_energies(y).values()) + sum(self.axis.stored_energies(y).values())
                 + sum(self.support_energies(mode, y).values()) + self.gravity_potential(y))
-
-
-def _first(ev: PlanarEvaluation) -> PlanarEvaluation:
-    """The one state of a batch of one, as floats."""
-    def one(v):
-        return float(np.asarray(v).reshape(-1)[0])
-    return PlanarEvaluation([one(F) for F in ev.forces], [one(a) for a in ev.accelerations], one(ev.support),
-                            qdd=np.asarray(ev.qdd)[:, 0], normal=[one(v) for v in ev.normal],
-                            tangential=[one(v) for v in ev.tangential],
-                            support_powers=[one(v) for v in ev.support_powers], powers=[one(v) for v in ev.powers],
-                            work_rates=[one(v) for v in ev.work_rates])
