@@ -21,8 +21,7 @@ import time
 import numpy as np
 
 from ..assembly import build_model
-from ..solver import _MAX_STALLS, ReferenceSolveError, _check_args, _hints, _integrate
-from ..switching import missed_crossing
+from ..solver import _check_args, _integrate, check_segment_count, count_stalls, segment_end
 from ..result import ReferenceSegment
 from .kinematics import Geometry
 from .model import PlanarModel
@@ -88,9 +87,7 @@ def solve_planar(scene, end_time: float = 1.0, *, method: str = "DOP853", rtol: 
     t, hints, stalls, nfev, previous = 0.0, {}, 0, 0, None
     segments: list[ReferenceSegment] = []
     while t < end_time:
-        if len(segments) >= max_segments:
-            raise ReferenceSolveError(f"more than {max_segments} smooth segments before t = {t:.9g} s "
-                                      f"(chattering / Zeno behaviour?) in scene {axis.name!r}")
+        check_segment_count(segments, max_segments, t, axis.name)
         k = bisect.bisect_right(time_events, t)
         t_bound = time_events[k] if k < len(time_events) else end_time
         restart = PlanarRestart(model, t, y, hints, previous)
@@ -103,21 +100,10 @@ def solve_planar(scene, end_time: float = 1.0, *, method: str = "DOP853", rtol: 
         rhs = model.rhs(mode)
         sol = _integrate(rhs, t, t_bound, y, options, mode)
         nfev += sol.nfev
-        hints = _hints(sol, funcs, names)
-        t_new, y = float(sol.t[-1]), sol.y[:, -1].copy()
-        missed = missed_crossing(sol.sol, funcs, names, t, t_new) if funcs and t_new > t else None
-        if missed is not None:
-            t_new, y = missed[0], sol.sol(missed[0])
-            hints = {missed[1]: dict(zip(names, funcs))[missed[1]].direction > 0}
+        t_new, y, hints = segment_end(sol, funcs, names, t)
         if t_new > t:
             segments.append(ReferenceSegment(t, t_new, mode, sol.sol))
-        if t_new - t <= 1e-14 * max(1.0, t):
-            stalls += 1
-            if stalls > _MAX_STALLS:
-                raise ReferenceSolveError(f"stuck at t = {t:.12g} s: {_MAX_STALLS} zero-length segments "
-                                          f"({mode}, events {sorted(hints)})")
-        else:
-            stalls = 0
+        stalls = count_stalls(stalls, t, t_new, mode, hints)
         t = t_new
         if t == t_bound and t < end_time:
             y = model.apply_impulses(t, y)
