@@ -54,7 +54,7 @@ def _anchor_jumps(model: PlanarModel, previous, mode, y: np.ndarray) -> np.ndarr
         return y
     y = y.copy()
     for k, s in enumerate(model.supports):
-        before, after = previous.supports[k].holding, mode.supports[k].holding
+        before, after = previous.supports[k].anchored, mode.supports[k].anchored
         if s.anchored and before != after:
             x_s = model.support_motion(s)(y)[0]
             energy = float(s.anchor_energy(x_s))

@@ -18,6 +18,14 @@ surfaces (events): ``p = 0`` (touch / leave the ground), the clipping surface wh
 or ``p + (c/k) p' = 0``: N reaches 0; the spade lets go there too) and ``u_s = +-v_reg`` (the friction's
 branches).
 
+A spade's law switches its horizontal force off where N reaches 0, so the clipping surface can hold the motion
+from both sides (Filippov): holding, the spade's force lifts the spade off the surface's far side (N would
+become < 0); let go, the weight presses it back (N would become > 0).  Then the spade *slides on the surface*
+(phase ``stick``): ``N = 0`` and the horizontal force is the share ``alpha`` (0 <= alpha <= 1) of the holding
+force that keeps the surface's rate 0 (a multiplier of the planar equations, :mod:`.model`); it ends where alpha
+reaches 0 (it lets go) or 1 (it holds again), events ``a0`` and ``a1``.  At a restart on the surface the spade
+slides iff the surface's rate is > 0 let go and < 0 holding.
+
 Energy: stored ``k max(p, 0)^(n+1) / (n+1)`` plus, for a spade holding, ``k_h (x_s - x_s0)^2 / 2``; dissipated
 power ``(N - k p^n) p' - T u_s`` (+ ``c_h u_s^2`` is ``-T u_s`` minus the spring's rate for a spade).  When a spade
 lets go (or takes hold again) its spring's energy leaves (or enters) the balance at once: the solver adds it to
@@ -30,7 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..terms.contact_laws import OFF, ON, ContactMode, Law
+from ..terms.contact_laws import OFF, ON, STICK, ContactMode, Law
 from ..switching import TOL_POS, TOL_S, heading
 
 
@@ -46,6 +54,16 @@ class SupportMode:
     def holding(self) -> bool:
         """Does the normal law act (N > 0 possible, a spade holds)?"""
         return self.contact.phase == ON
+
+    @property
+    def sliding(self) -> bool:
+        """Does a spade slide on its clipping surface (N = 0, a share of its horizontal force, module docstring)?"""
+        return self.contact.phase == STICK
+
+    @property
+    def anchored(self) -> bool:
+        """Is a spade's spring engaged (holding or sliding): its energy is stored."""
+        return self.contact.phase in (ON, STICK)
 
 
 class Support:
@@ -92,12 +110,17 @@ class Support:
             return self.law.stiffness * p + self.law.damping * rate
         return self.elastic(p) * (1.0 + mode.contact.factor * rate)
 
-    def tangential(self, mode: SupportMode, normal, x, u):
-        """T (N) in ``mode`` from N (N), the point's x (m) and horizontal velocity u (m/s)."""
+    def spade_force(self, x, u):
+        """``-(k_h (x - x0) + c_h u)`` (N): a holding spade's horizontal force."""
+        return -(self.horizontal_stiffness * (x - self.anchor) + self.horizontal_damping * u)
+
+    def tangential(self, mode: SupportMode, normal, x, u, share=0.0):
+        """T (N) in ``mode`` from N (N), the point's x (m) and horizontal velocity u (m/s); a sliding spade's
+        ``share`` (alpha) of its holding force."""
         if self.anchored:
-            if not mode.holding:
-                return 0.0 * u
-            return -(self.horizontal_stiffness * (x - self.anchor) + self.horizontal_damping * u)
+            if mode.holding:
+                return self.spade_force(x, u)
+            return share * self.spade_force(x, u) if mode.sliding else 0.0 * u
         if self.friction == 0.0:
             return 0.0 * u
         if mode.slip:
@@ -108,7 +131,7 @@ class Support:
         """``k max(p, 0)^(n+1) / (n+1)`` plus a holding spade's ``k_h (x - x0)^2 / 2`` (J)."""
         n = self.law.exponent
         out = self.law.stiffness * np.maximum(p, 0.0) ** (n + 1.0) / (n + 1.0)
-        if self.anchored and mode is not None and mode.holding:
+        if self.anchored and mode is not None and mode.anchored:
             out = out + self.anchor_energy(x)
         return out
 
@@ -122,7 +145,7 @@ class Support:
         if mode.contact.penetrated or mode.contact.phase == ON:
             out = (normal - self.elastic(p)) * rate
         out = out - tangential * u
-        if self.anchored and mode.holding:
+        if self.anchored and mode.anchored:
             out = out - self.horizontal_stiffness * (x - self.anchor) * u
         return out
 
@@ -167,27 +190,46 @@ class Support:
         return 0
 
     def classify(self, p: float, rate: float, free: float, u: float, du: float, hints: dict,
-                 previous: SupportMode | None) -> SupportMode:
-        """The state at a restart from ``p``, ``p'``, the free ``p''`` (this support's normal force left out), the
-        point's u and du/dt, the hints of the event that stopped the segment (``p``, ``s``, ``u+``, ``u-``: True if
-        crossed upwards) and the previous state."""
+                 previous: SupportMode | None, free_holding: float | None = None) -> SupportMode:
+        """The state at a restart from ``p``, ``p'``, the free ``p''`` (this support's forces left out), the
+        point's u and du/dt, the hints of the event that stopped the segment (``p``, ``s``, ``u+``, ``u-``, ``a0``,
+        ``a1``: True if crossed upwards) and the previous state; ``free_holding``: a spade's ``p''`` with N = 0 and
+        its whole horizontal force (whether it slides on the clipping surface, module docstring)."""
         slip = self._branch(u, du, hints)
         if not (hints["p"] if "p" in hints else heading(p, rate, free)):
             return SupportMode(ContactMode(OFF), slip)
         factor, onset = self._episode(rate, None if previous is None else previous.contact)
-        if self.law.has_clipping_surface:
-            tol = TOL_POS if self.law.kelvin_voigt else TOL_S
-            above = hints["s"] if "s" in hints else heading(self.surface(p, rate, factor),
-                                                             self.surface_rate(rate, free, factor), tol=tol)
-            if not above:
-                return SupportMode(ContactMode(OFF, True, True, factor, onset), slip)
-        return SupportMode(ContactMode(ON, True, False, factor, onset), slip)
+        acting = ContactMode(ON, True, False, factor, onset)
+        clipped = ContactMode(OFF, True, True, factor, onset)
+        if not self.law.has_clipping_surface:
+            return SupportMode(acting, slip)
+        if "a0" in hints:      # a sliding spade's share fell to 0: it lets go
+            return SupportMode(clipped, slip)
+        if "a1" in hints:      # rose to 1: it holds
+            return SupportMode(acting, slip)
+        tol = TOL_POS if self.law.kelvin_voigt else TOL_S
+        value = self.surface(p, rate, factor)
+        if self.anchored and free_holding is not None and ("s" in hints or abs(value) <= tol):
+            let_go = self.surface_rate(rate, free, factor)
+            holding = self.surface_rate(rate, free_holding, factor)
+            if let_go > 0.0 > holding:
+                return SupportMode(ContactMode(STICK, True, False, factor, onset), slip)
+        above = hints["s"] if "s" in hints else heading(value, self.surface_rate(rate, free, factor), tol=tol)
+        return SupportMode(acting if above else clipped, slip)
 
-    def events(self, mode: SupportMode, motion) -> list[tuple]:
+    def sliding_condition(self, mode: SupportMode, rate):
+        """``(A, B)`` with the clipping surface's rate ``A + B p''`` (p' = ``rate``): a sliding spade holds it at 0."""
+        if self.law.kelvin_voigt:
+            return rate, self.law.damping / self.law.stiffness
+        return 0.0 * rate, mode.contact.factor
+
+    def events(self, mode: SupportMode, motion, share=None) -> list[tuple]:
         """``(event, g(t, y), positive)`` of the surfaces watched in ``mode``; ``motion(y)`` gives
-        ``(x_s, y_s, u_s, w_s)`` of a planar state or batch."""
+        ``(x_s, y_s, u_s, w_s)`` of a planar state or batch, ``share(t, y)`` a sliding spade's alpha."""
         items = [("p", lambda t, y: -motion(y)[1], mode.contact.penetrated)]
-        if mode.contact.penetrated and self.law.has_clipping_surface:
+        if mode.sliding:
+            items += [("a0", share, True), ("a1", lambda t, y: share(t, y) - 1.0, False)]
+        elif mode.contact.penetrated and self.law.has_clipping_surface:
             factor, surface = mode.contact.factor, self.surface
 
             def clip(t, y):

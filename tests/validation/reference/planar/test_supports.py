@@ -66,3 +66,23 @@ def test_the_contact_is_classified_by_side_and_heading():
     # penetrated but leaving faster than k/c allows: below the clipping surface p + (c/k) p' = 0
     clipped = s.classify(1e-6, -1.0, 0.0, 0.0, 0.0, {}, None)
     assert clipped.contact.penetrated and clipped.contact.clipped and not clipped.holding
+
+
+def test_a_spade_on_its_clipping_surface_slides_where_both_sides_push_onto_it():
+    """p + (c/k) p' = 0 (N = 0): let go, p'' = 1e3 makes the surface's rate p' + (c/k) p'' > 0; holding, p'' = -50
+    makes it < 0: the spade slides (N = 0, a share of its force).  Where both agree it goes their way; the events
+    of the share (a0, a1) end the slide."""
+    s = Support(table(horizontal_stiffness=2.0e8, horizontal_damping=1.0e6))
+    c_over_k = 1.0e5 / 1.0e8
+    p, rate = 1e-6, -1e-6 / c_over_k                                  # on the surface
+    assert s.surface(p, rate, 0.0) == pytest.approx(0.0, abs=1e-18)
+    slide = s.classify(p, rate, 1e3, 0.0, 0.0, {"s": False}, None, free_holding=-50.0)
+    # rates by hand: let go 1e3 -> -1e-3 + 1e-3 * 1e3 = 0.999 > 0; holding -50 -> -1e-3 - 0.05 < 0: slides
+    assert slide.sliding and not slide.holding and slide.anchored
+    assert not s.classify(p, rate, -10.0, 0.0, 0.0, {"s": False}, None, free_holding=-50.0).sliding
+    assert s.classify(p, rate, 1e3, 0.0, 0.0, {"s": True}, None, free_holding=1e3).holding
+    assert s.classify(p, rate, 1e3, 0.0, 0.0, {"a1": True}, None, free_holding=-50.0).holding
+    assert not s.classify(p, rate, 1e3, 0.0, 0.0, {"a0": False}, None, free_holding=-50.0).anchored
+    names = [e[0] for e in s.events(slide, lambda y: (0.0, 0.0, 0.0, 0.0), lambda t, y: 0.5)]
+    assert names == ["p", "a0", "a1"]
+    assert s.tangential(slide, 0.0, s.anchor + 1e-5, 0.0, share=0.25) == pytest.approx(-0.25 * 2.0e8 * 1e-5)
