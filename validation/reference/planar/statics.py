@@ -11,7 +11,7 @@ the ground and the pitch), in the equilibrium of its vertical force and its mome
 (at rest the friction and a spade anchored at its own static x give no tangential force, so ``Q_X = 0``
 holds for any X; the holding forces on the axis coordinates are internal).  Solved for ``(Y, phi)`` with
 ``scipy.optimize.root`` (Powell's hybrid method) from the rigid-support guess, the residual scaled by the
-weight; a solution with every support in contact and the residual below 1e-12 of the weight is required.
+weight; a solution with every support in contact and the residual below 1e-10 of the weight is required.
 """
 
 from __future__ import annotations
