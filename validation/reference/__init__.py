@@ -13,6 +13,9 @@ checks what it imports against an allow-list.  SI units throughout (m, s, kg, N,
   and :class:`~.model.Impulse` velocity jumps (the later shots of a ``[burst]``); their breakpoints and
   times split the solve, their work is in the energy balance (``ReferenceResult.work_history``); the
   result's ``shots`` gives the per-shot outputs, ``pulse_impulse`` the pulse's impulse;
+* :mod:`.planar` -- the gun on its carriage (a scene with ``[carriage]``): the same axis model moved by a carriage
+  on its supports (Lagrange's equations by hand); :func:`solve_reference` dispatches to it and returns a
+  :class:`~.planar.PlanarResult` (the carriage's histories and metrics besides the axis');
 * :mod:`.closed_form` -- oracles: :func:`simplified_max_displacement`, :func:`hunt_crossley_restitution`,
   :func:`restitution_factor`, :func:`exact_restitution_factor`, :func:`achieved_restitution`,
   :func:`kelvin_voigt_restitution`.

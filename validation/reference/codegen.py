@@ -13,7 +13,10 @@ joins them, for one :class:`~validation.reference.model.Mode`, into one function
 
 Kinds: ``"rhs"`` (Python floats; ``dy/dt``, inf where the arithmetic overflows, as numpy would give),
 ``"scalar"`` and ``"array"`` (one state on Python floats, or numpy rows: the raw forces, the
-accelerations and the support force ``fg`` = S; ``omit`` leaves one connector out).  The same source
+accelerations and the support force ``fg`` = S; ``omit`` leaves one connector out), ``"axis"`` and
+``"axis_array"`` (the same on floats or rows for the planar model, :mod:`validation.reference.planar`: the
+connectors alone -- no loads, no constraints, whose forces the planar model solves for -- returning the raw
+forces, the force ``f_i`` (N) on every body, ``fg`` and the dissipated powers of the dissipating connectors).  The same source
 serves all three: only ``copysign`` differs (``math`` or ``numpy``).  Constants are written with
 ``repr`` (exact); a callable constant (a connector's law, :meth:`Connector.equations`'s default) is called by
 name.  ``source(...)`` shows the code of a mode.
@@ -52,6 +55,7 @@ _NAMESPACES = {
     "scalar": {"copysign": math.copysign, "ratio_power": _ratio_power},
     "array": {"copysign": np.copysign, "ratio_power": _ratio_power_array},
 }
+_NAMESPACES["axis"], _NAMESPACES["axis_array"] = _NAMESPACES["scalar"], _NAMESPACES["array"]
 
 
 def _point(model, body) -> tuple[str, str, str]:
@@ -67,10 +71,11 @@ def source(model, mode, kind: str, omit: int | None = None, functions: dict | No
     functions = {} if functions is None else functions
     nb = model.n_bodies
     names = [n for i in range(nb) for n in (f"x{i}", f"v{i}")] + ["_"] * (model.n_states - 2 * nb)
-    unpack = "y" if kind == "array" else "y.tolist()"
+    axis = kind.startswith("axis")
+    unpack = "y" if kind in ("array", "axis_array") else "y.tolist()"
     body = [f"{', '.join(names)}, = {unpack}", " = ".join([f"f{i}" for i in range(nb)] + ["fg", "0.0"])]
     works = []
-    for k, load in enumerate(model.loads):
+    for k, load in enumerate(() if axis else model.loads):
         i = model.body_index[load.body]
         code = load.equations(mode.loads[k]) if mode.loads else f"{{L}} = load{k}(t)"
         if code is None:
@@ -84,7 +89,7 @@ def source(model, mode, kind: str, omit: int | None = None, functions: dict | No
     forces, powers = {}, {}
     for j, (c, state) in enumerate(zip(model.connectors, mode.states)):
         equations = None if j == omit else c.equations(state)
-        if equations is None:
+        if equations is None or (axis and equations.constraint):
             continue
         xa, va, fa = _point(model, c.body_a)
         xb, vb, fb = _point(model, c.body_b)
@@ -113,6 +118,10 @@ def source(model, mode, kind: str, omit: int | None = None, functions: dict | No
         return (f"def rhs(t, y):\n    try:\n{inner}\n    except OverflowError:\n"
                 f"        return full({model.n_states}, inf)\n")
     all_forces = [forces.get(j, "0.0") for j in range(len(model.connectors))]
+    if axis:
+        body.append(f"return [{', '.join(all_forces)}], [{', '.join(f'f{i}' for i in range(nb))}], fg, "
+                    f"[{', '.join(powers.get(c.index, '0.0') for c in model.dissipating)}]")
+        return "def evaluate(y):\n" + "\n".join("    " + line for line in body) + "\n"
     body.append(f"return [{', '.join(all_forces)}], [{', '.join(accelerations)}], fg")
     signature = "y, t" if model.loads else "y"
     return f"def evaluate({signature}):\n" + "\n".join("    " + line for line in body) + "\n"

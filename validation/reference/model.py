@@ -591,6 +591,12 @@ class Model:
         self._compiled: dict = {}
 
     # ------------------------------------------------------------------ state
+    @property
+    def axis_states(self) -> int:
+        """Length of the axis' state (the 1-D layout): all of it here; the first part of a planar state
+        (:mod:`validation.reference.planar`)."""
+        return self.n_states
+
     def initial_state(self) -> np.ndarray:
         """y(0): every body at its initial position (0 but for a preload's hold) with its initial velocity, no
         dissipated energy."""

@@ -92,6 +92,37 @@ def _refine_last_step(sol, rhs, t1: float, options: dict, mode):
     return again
 
 
+def segment_end(sol, funcs, names, t: float):
+    """``(t_new, y, hints)`` where a segment that started at ``t`` ends: the solver's last state and the events
+    that stopped it, or the first crossing inside it that the step-end sign checks missed (then the state there,
+    from the dense output)."""
+    hints = _hints(sol, funcs, names)
+    t_new, y = float(sol.t[-1]), sol.y[:, -1].copy()
+    missed = missed_crossing(sol.sol, funcs, names, t, t_new) if funcs and t_new > t else None
+    if missed is not None:
+        t_new, y = missed[0], sol.sol(missed[0])
+        hints = {missed[1]: dict(zip(names, funcs))[missed[1]].direction > 0}
+    return t_new, y, hints
+
+
+def check_segment_count(segments, max_segments: int, t: float, name: str) -> None:
+    """ReferenceSolveError once ``max_segments`` segments are reached (chattering / Zeno behaviour)."""
+    if len(segments) >= max_segments:
+        raise ReferenceSolveError(f"more than {max_segments} smooth segments before t = {t:.9g} s "
+                                  f"(chattering / Zeno behaviour?) in scene {name!r}")
+
+
+def count_stalls(stalls: int, t: float, t_new: float, mode, hints) -> int:
+    """The count of consecutive zero-length segments after one from ``t`` to ``t_new``; ReferenceSolveError
+    beyond :data:`_MAX_STALLS`."""
+    if t_new - t > 1e-14 * max(1.0, t):
+        return 0
+    if stalls + 1 > _MAX_STALLS:
+        raise ReferenceSolveError(f"stuck at t = {t:.12g} s: {_MAX_STALLS} zero-length segments "
+                                  f"({mode}, events {sorted(hints)})")
+    return stalls + 1
+
+
 def _check_args(scene, end_time, method, rtol, atol, impact_threshold, max_step, max_segments):
     if not (callable(getattr(scene, "tables", None)) and hasattr(scene, "barrel")):
         raise TypeError(f"scene must be a scene (tables read as data), got {type(scene).__name__}")
@@ -139,12 +170,20 @@ def solve_reference(scene, end_time: float = 10.0, *, method: str = "DOP853", rt
         closed form without, 2e-10 with; the late, weak impacts of model (i), m = 500 kg, gap 0 have
         peaks 2.8e-7 off a rtol = 1e-13 run without, 1.5e-8 with.
 
+    A scene with ``[carriage]`` is solved by the planar model (:func:`validation.reference.planar.solve_planar`,
+    a :class:`~validation.reference.planar.PlanarResult`).
+
     Raises
     ------
     ReferenceSolveError: solver failure, non-finite state, or chattering (too many segments).
     ReferenceModelError: a scene table the reference has no term for.
     ValueError: a bad argument (names it).
     """
+    if getattr(scene, "carriage", None) is not None:  # the gun on its carriage: the planar model
+        from .planar import solve_planar
+        return solve_planar(scene, end_time, method=method, rtol=rtol, atol=atol, impact_threshold=impact_threshold,
+                            max_step=max_step, max_segments=max_segments, stop_when_final=stop_when_final,
+                            refine_releases=refine_releases)
     _check_args(scene, end_time, method, rtol, atol, impact_threshold, max_step, max_segments)
     requested = check_names(stop_when_final)
     model = build_model(scene)
@@ -161,9 +200,7 @@ def solve_reference(scene, end_time: float = 10.0, *, method: str = "DOP853", rt
     t, hints, stalls, nfev, previous = 0.0, {}, 0, 0, None
     segments: list[ReferenceSegment] = []
     while t < end_time:
-        if len(segments) >= max_segments:
-            raise ReferenceSolveError(f"more than {max_segments} smooth segments before t = {t:.9g} s "
-                                      f"(chattering / Zeno behaviour?) in scene {model.name!r}")
+        check_segment_count(segments, max_segments, t, model.name)
         k = bisect.bisect_right(time_events, t)
         t_bound = time_events[k] if k < len(time_events) else end_time
         restart = Restart(model, t, y, hints, previous)
@@ -178,12 +215,7 @@ def solve_reference(scene, end_time: float = 10.0, *, method: str = "DOP853", rt
         if refine_releases and set(hints) & restart.rough and len(sol.t) >= 2:
             sol = _refine_last_step(sol, model.rhs(mode), t_bound, options, mode)
             nfev += sol.nfev_refinement
-            hints = _hints(sol, funcs, names)
-        t_new, y = float(sol.t[-1]), sol.y[:, -1].copy()
-        missed = missed_crossing(sol.sol, funcs, names, t, t_new) if funcs and t_new > t else None
-        if missed is not None:
-            t_new, y = missed[0], sol.sol(missed[0])
-            hints = {missed[1]: dict(zip(names, funcs))[missed[1]].direction > 0}
+        t_new, y, hints = segment_end(sol, funcs, names, t)
         if t_new > t:
             segments.append(ReferenceSegment(t, t_new, mode, sol.sol))
         if early and t_new > t:
@@ -194,13 +226,7 @@ def solve_reference(scene, end_time: float = 10.0, *, method: str = "DOP853", rt
                     finality.check(y, mode, METRICS)  # which others are final here too
                     t = t_new
                     break
-        if t_new - t <= 1e-14 * max(1.0, t):
-            stalls += 1
-            if stalls > _MAX_STALLS:
-                raise ReferenceSolveError(f"stuck at t = {t:.12g} s: {_MAX_STALLS} zero-length segments "
-                                          f"({mode}, events {sorted(hints)})")
-        else:
-            stalls = 0
+        stalls = count_stalls(stalls, t, t_new, mode, hints)
         t = t_new
         if t == t_bound and t < end_time:  # a time event: the jumps firing now, then a restart
             y = model.apply_impulses(t, y)

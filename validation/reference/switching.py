@@ -115,7 +115,7 @@ class Restart:
     def __init__(self, model: Model, t: float, y: np.ndarray, hints: dict[str, bool], previous: Mode | None):
         self.model, self.t, self.y, self.previous = model, t, y, previous
         self._hints = hints
-        self.s = y.tolist() + [0.0, 0.0]
+        self.s = np.asarray(y)[:model.axis_states].tolist() + [0.0, 0.0]  # the axis' state, then the ground
         x = [abs(v) for v in self.s[0:2 * model.n_bodies:2]]
         v = [abs(w) for w in self.s[1:2 * model.n_bodies:2]]
         #: round-off levels of positions (m) and velocities (m/s)

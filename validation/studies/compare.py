@@ -3,6 +3,12 @@
 The engine is :func:`mbs_models.simulate` (Exudyn); the reference is :func:`validation.reference.solve_reference`
 (scipy, event-driven, tight tolerances).  :func:`compare` runs both and judges each quantity against
 a stated tolerance; :attr:`Comparison.passed` is the verdict ``recoil validate`` turns into its exit code.
+
+A scene with ``[carriage]`` (the planar model, DESIGN.md "The recoil axis on a carriage") also compares the
+carriage's metrics (:data:`CARRIAGE_METRICS`), every support's static, min and max normal force and the
+carriage's pitch and CG position histories (:func:`carriage_checks`): the engine's ``Result.metrics()`` keys,
+``Result.supports``, ``Result.carriage_position`` ((n, 2), m) and ``Result.carriage_pitch`` ((n,), rad) on
+``Result.time`` against the reference's :class:`~validation.reference.planar.PlanarResult`.
 """
 
 from __future__ import annotations
@@ -30,7 +36,20 @@ DEFAULT_TOLERANCES = {
     "time_of_max_absorber_velocity": 1e-2,
     # max error of a time history on a common grid, relative to the history's largest magnitude
     "position_history": 1e-3,
+    # the carriage (scenes with [carriage]); stability_margin and lift_off_time near 0 compare absolutely
+    "max_carriage_pitch": 1e-3,
+    "max_lift": 1e-2,
+    "lift_off_time": 1e-3,
+    "max_carriage_displacement": 1e-3,
+    "stability_margin": 1e-3,
+    "support_normal_force": 1e-3,
+    # max error of the carriage's pitch / CG position history at the engine's steps, relative to its largest
+    # change from t = 0
+    "carriage_history": 1e-3,
 }
+#: The carriage's scalar metrics compared on a scene with [carriage] (keys of both ``metrics()``).
+CARRIAGE_METRICS = ("max_carriage_pitch", "max_lift", "lift_off_time", "max_carriage_displacement",
+                    "stability_margin")
 
 
 @dataclass(frozen=True)
@@ -61,14 +80,19 @@ class QuantityCheck:
 
 
 def quantity_unit(name: str) -> str:
-    """``s`` for a time, ``N`` for a force, ``m/s`` for a velocity, ``m`` for a displacement or position."""
-    if name.startswith("time_of_"):
+    """``s`` for a time, ``N`` for a force, ``m/s`` for a velocity, ``rad`` for a pitch, ``1`` for a margin, ``m``
+    for a displacement, a position or a lift."""
+    if name.startswith("time_of_") or name.endswith("_time"):
         return "s"
+    if "pitch" in name:
+        return "rad"
+    if "margin" in name:
+        return "1"
     if name.endswith("force"):
         return "N"
     if "velocity" in name:
         return "m/s"
-    if "displacement" in name or "position" in name:
+    if "displacement" in name or "position" in name or "lift" in name:
         return "m"
     raise ValueError(f"no unit known for the quantity {name!r}")
 
@@ -152,12 +176,61 @@ def history_error(engine: Result, reference: ReferenceResult, body: str, points:
     return float(np.max(np.abs(ours - theirs)) / scale) if scale > 0 else float(np.max(np.abs(ours - theirs)))
 
 
+def history_change_check(name: str, time, ours, reference_history, tolerance: float) -> QuantityCheck:
+    """A carriage history at the engine's steps ``time``: engine and reference values are each history's largest
+    change from its value at t = 0; the error is max |ours - reference| relative to the reference's change
+    (absolute if it does not change).  Without the engine's history (None) the check fails."""
+    theirs = np.asarray(reference_history(np.asarray(time, dtype=float)), dtype=float)
+    reference_change = float(np.max(np.abs(theirs - theirs[..., :1])))
+    if ours is None:
+        return QuantityCheck(name, None, reference_change, None, tolerance)
+    ours = np.asarray(ours, dtype=float).reshape(theirs.shape)
+    error = float(np.max(np.abs(ours - theirs)))
+    return QuantityCheck(name, float(np.max(np.abs(ours - ours[..., :1]))), reference_change,
+                         error / reference_change if reference_change > 0 else error, tolerance)
+
+
+def carriage_checks(engine, reference, tolerances: dict[str, float]) -> list[QuantityCheck]:
+    """The carriage's quantities (module docstring): :data:`CARRIAGE_METRICS`, per support
+    ``support.NAME.static_normal_force`` / ``min_normal_force`` / ``max_normal_force`` (tolerance
+    ``support_normal_force``, relative to the support's static load), ``carriage_pitch_history`` and
+    ``carriage_position_history`` (``carriage_history``).  An engine without them fails these checks."""
+    ours = engine.metrics() if callable(getattr(engine, "metrics", None)) else {}
+    theirs = reference.metrics()
+    checks = []
+    for name in CARRIAGE_METRICS:
+        a, b = ours.get(name), theirs.get(name)
+        error = _relative(a, b)
+        if name in ("stability_margin", "lift_off_time") and a is not None and b is not None:
+            error = abs(a - b) / max(abs(b), 1.0)  # a margin or a time near 0: absolute
+        checks.append(QuantityCheck(name, a, b, error, tolerances[name]))
+    engine_supports = {s["name"]: s for s in (getattr(engine, "supports", None) or [])}
+    for support in reference.supports():
+        mine = engine_supports.get(support["name"], {})
+        scale = abs(support["static_normal_force"])
+        for key in ("static_normal_force", "min_normal_force", "max_normal_force"):
+            a, b = mine.get(key), support[key]
+            error = None if a is None else abs(a - b) / scale
+            checks.append(QuantityCheck(f"support.{support['name']}.{key}", a, b, error,
+                                        tolerances["support_normal_force"]))
+    time = engine.time
+    pitch = getattr(engine, "carriage_pitch", None)
+    position = getattr(engine, "carriage_position", None)
+    checks.append(history_change_check("carriage_pitch_history", time, pitch, reference.carriage_pitch,
+                                       tolerances["carriage_history"]))
+    checks.append(history_change_check("carriage_position_history", time,
+                                       None if position is None else np.asarray(position).T,
+                                       reference.carriage_position, tolerances["carriage_history"]))
+    return checks
+
+
 def compare_results(engine: Result, reference: ReferenceResult, tolerances: dict[str, float] | None = None,
                     accuracy: str = "standard") -> Comparison:
     """Judge an engine result against a reference result of the same scene.
 
     Quantities: the metrics of :data:`DEFAULT_TOLERANCES` (over all absorbers), every contact's peak force
-    when the scene has more than one contact, and every body's position history.
+    when the scene has more than one contact, every body's position history and, on a carriage, the carriage's
+    quantities (:func:`carriage_checks`).
     """
     tolerances = {**DEFAULT_TOLERANCES, **(tolerances or {})}
     checks = []
@@ -173,6 +246,8 @@ def compare_results(engine: Result, reference: ReferenceResult, tolerances: dict
     for body in engine.positions:
         checks.append(QuantityCheck(f"{body}_position_history", None, None, history_error(engine, reference, body),
                                     tolerances["position_history"]))
+    if getattr(engine.scene, "carriage", None) is not None:
+        checks += carriage_checks(engine, reference, tolerances)
     engine_impacts = sum(len(c.impacts) for c in engine.contacts.values())
     reference_impacts = sum(len(c.impacts) for c in reference.contacts.values())
     return Comparison(scene=engine.scene, end_time=engine.end_time, accuracy=accuracy, checks=checks,

@@ -80,3 +80,23 @@ def test_solving_a_scene_file_loads_no_engine(tmp_path, every_element, design_co
     bad = [m for m in result["modules"] if m == "exudyn" or m.startswith(("exudyn.", "mbs_models.engine"))
            or m in ("mbs_models.simulation", "mbs_models.assembly", "mbs_models.final_metrics")]
     assert not bad, bad
+
+
+def test_solving_a_carriage_scene_loads_no_engine(tmp_path):
+    """The planar reference (a scene with [carriage]) reads the scene as data too: no engine, no Exudyn, and
+    nothing of the engine's carriage or contact laws beyond the scene's own tables."""
+    from planar_scenes import carriage_scene
+
+    path = tmp_path / "gun.toml"
+    path.write_text(scene_to_toml(carriage_scene()))
+    result = _run("import sys, json\n"
+                  "from mbs_models import load_scene\n"
+                  "from validation.reference import solve_reference\n"
+                  f"r = solve_reference(load_scene({str(path)!r}), 0.05, method='LSODA')\n"
+                  "print(json.dumps({'modules': sorted(sys.modules), 'type': type(r).__name__,\n"
+                  "                  'margin': r.stability_margin}))\n")
+    assert result["type"] == "PlanarResult" and 0.0 <= result["margin"] <= 1.0
+    assert "validation.reference.planar.kinematics" in result["modules"]
+    bad = [m for m in result["modules"] if m == "exudyn" or m.startswith(("exudyn.", "mbs_models.engine"))
+           or m in ("mbs_models.simulation", "mbs_models.assembly", "mbs_models.final_metrics")]
+    assert not bad, bad

@@ -88,3 +88,56 @@ def test_validate_bad_scene_is_exit_2(tmp_path, capsys):
     path = tmp_path / "s.toml"
     path.write_text("[barrel]\nmass = -1\n")
     assert main(["validate", str(path)]) == 2
+
+
+# ------------------------------------------------------------------ the carriage (planar model)
+class _PlanarEngine:
+    """An engine result of a carriage scene with the engine's interface (``Result.metrics()``, ``supports``,
+    ``carriage_position`` (n, 2), ``carriage_pitch`` (n,) on ``time``), sampled from a reference result."""
+
+    def __init__(self, reference, pitch_scale=1.0, supports=True, metrics=True):
+        import numpy as np
+        self.scene, self.end_time = reference.scene, reference.end_time
+        self.time = np.linspace(0.0, reference.end_time, 4001)
+        self.positions = {b: reference.position(b, self.time) for b in reference.bodies}
+        self.velocities = {b: reference.velocity(b, self.time) for b in reference.bodies}
+        self.contacts = {}
+        for name in ("max_barrel_displacement", "time_of_max_barrel_displacement", "peak_support_force",
+                     "peak_contact_force", "max_absorber_velocity", "time_of_max_absorber_velocity"):
+            setattr(self, name, getattr(reference, name))
+        self._metrics = reference.metrics() if metrics else {}
+        self.supports = reference.supports() if supports else None
+        self.carriage_position = reference.carriage_position(self.time).T
+        phi0 = reference.carriage_pitch(0.0)
+        self.carriage_pitch = phi0 + pitch_scale * (reference.carriage_pitch(self.time) - phi0)
+
+    def metrics(self):
+        return self._metrics
+
+
+@pytest.fixture(scope="module")
+def carriage_reference():
+    from planar_scenes import carriage_scene
+    return solve_reference(carriage_scene(), 0.1, method="LSODA")
+
+
+def test_a_carriage_comparison_checks_the_carriages_quantities(carriage_reference):
+    from validation.studies.compare import CARRIAGE_METRICS, compare_results
+    comparison = compare_results(_PlanarEngine(carriage_reference), carriage_reference)
+    names = [c.name for c in comparison.checks]
+    assert set(CARRIAGE_METRICS) <= set(names)
+    assert {"support.spade.min_normal_force", "support.wheels.max_normal_force", "carriage_pitch_history",
+            "carriage_position_history"} <= set(names)
+    assert comparison.passed, comparison.table()
+    assert comparison.check("max_carriage_pitch").unit == "rad" and comparison.check("lift_off_time").unit == "s"
+    assert comparison.check("stability_margin").unit == "1" and comparison.check("max_lift").unit == "m"
+    assert "carriage_pitch_history" in comparison.table()
+
+
+@pytest.mark.parametrize("change, failing", [({"pitch_scale": 1.01}, "carriage_pitch_history"),
+                                             ({"supports": False}, "support.wheels.min_normal_force"),
+                                             ({"metrics": False}, "stability_margin")])
+def test_a_carriage_comparison_fails_on_a_wrong_or_missing_quantity(carriage_reference, change, failing):
+    from validation.studies.compare import compare_results
+    comparison = compare_results(_PlanarEngine(carriage_reference, **change), carriage_reference)
+    assert not comparison.passed and failing in comparison.failures

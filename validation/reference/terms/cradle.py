@@ -19,7 +19,9 @@ DESIGN.md, "Inclined cradle".  With the elevation theta (degrees), g (m/s^2), mu
   Dissipated power ``F v_M`` (>= 0: F has the sign of v_M, and v_M = 0 while stuck); ``|F| <= mu N``
   (the early stop's force bound); no potential.
 
-``mu N = 0`` adds no connector, ``sin(theta) = 0`` no load.  The engine regularises the same law
+``mu N = 0`` adds no connector, ``sin(theta) = 0`` no load.  On a carriage (``[carriage]``, DESIGN.md "The recoil
+axis on a carriage") the load is not added: the planar model (:mod:`validation.reference.planar`) pulls every
+body vertically; the friction keeps ``N = M g cos(theta)``.  The engine regularises the same law
 (:mod:`mbs_models.elements.cradle`); the difference is the creep its regularisation allows.  The
 sliding mode of the ``compression_only`` reading is another constraint on the barrel: the two together
 are not modelled (ReferenceModelError).
@@ -131,7 +133,7 @@ def build(builder, key: str, table) -> None:
     g, mu = float(table.gravity), float(table.friction_coefficient)
     normal = 0.0 if abs(float(table.elevation)) == 90.0 else mass * g * math.cos(theta)
     along = mass * g * math.sin(theta)
-    if along != 0.0:
+    if along != 0.0 and getattr(builder.scene, "carriage", None) is None:
         builder.add_load(ConstantLoad("gravity", BARREL, along))
     if mu * normal > 0.0:
         if builder.scene.conventions.compression_only:
