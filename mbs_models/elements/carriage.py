@@ -122,10 +122,6 @@ class Support(LawFields, Table):
         if self.anchor != "rest" and not (self.horizontal_stiffness or self.horizontal_damping):
             raise SceneError(f"{self.TABLE}.anchor", "is a spade's (it places the horizontal anchor): give "
                                                      "horizontal_stiffness or horizontal_damping, or drop it")
-        if self.contact_law.restitution:
-            raise SceneError(f"{self.TABLE}.law", f"law {self.law!r} needs the rate at each touch-down, which "
-                                                  f"supports do not capture yet: use hunt-crossley, hertz or "
-                                                  f"kelvin-voigt")
         anchored = self.horizontal_stiffness is not None or self.horizontal_damping is not None
         if anchored and self.friction_coefficient is not None:
             raise SceneError(f"{self.TABLE}.friction_coefficient",
@@ -270,11 +266,12 @@ def axis_point(carriage: Carriage, elevation: float, x: float) -> tuple[float, f
 
 
 # ================================================================================================ the support law
-def support_normal_force(support: Support, height, height_rate, ops: Ops):
-    """N (N, >= 0): the support's contact law at penetration ``p = -height`` (m) and rate ``p' = -height_rate``."""
+def support_normal_force(support: Support, height, height_rate, ops: Ops, lam=None):
+    """N (N, >= 0): the support's contact law at penetration ``p = -height`` (m) and rate ``p' = -height_rate``;
+    ``lam`` (s/m): a restitution law's ``chi / max(v-, floor)`` of the episode (captured at its touch-down)."""
     return law_force(-height, -height_rate, support.law, support.stiffness, support.law_exponent, 0.0, ops,
                      damping_factor=support.damping_factor if support.law == "hunt-crossley" else None,
-                     damping=support.damping or 0.0)
+                     damping=support.damping or 0.0, lam=lam)
 
 
 def support_tangential_force(support: Support, normal, x, x_rate, anchor: float, ops: Ops, height=None):

@@ -146,7 +146,7 @@ def _pre_step_function(assembly: Assembly, budget: StepBudget | None, tracker: F
         ib = None if contact.b == "ground" else assembly.coordinates[contact.b]
         captures.append((contact.capture, ia, ib))
     observe = tracker.observe if tracker is not None else None
-    planar = assembly.planar if assembly.planar is not None and assembly.planar.anchors else None
+    planar = assembly.planar if assembly.planar is not None and assembly.planar.captures else None
     if planar is not None:  # the carriage's touchdown anchors see the tree's state at every step start
         tree = list(data.GetNodeLTGODE2(planar.node))
     steps = 0  # calls so far (all segments of a run): the budget's step count and the tracker's cadence
@@ -224,7 +224,7 @@ def _solve(assembly: Assembly, settings: SolverSettings, end_time: float,
         run["budget"] = None
         if settings.adaptive:  # every adaptive solve: bounded steps and stored samples (engine/guard.py)
             run["budget"] = StepBudget.for_run(run.get("end_time", end_time), len(assembly.sensors))
-        anchors = assembly.planar is not None and assembly.planar.anchors
+        anchors = assembly.planar is not None and assembly.planar.captures
         if run["budget"] is not None or tracker is not None or assembly.mechanism.capturing_contacts or anchors:
             run["pre_step"] = _pre_step_function(assembly, run["budget"], tracker)
             mbs.SetPreStepUserFunction(run["pre_step"])

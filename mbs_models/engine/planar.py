@@ -40,6 +40,7 @@ import numpy as np
 
 from ..elements.carriage import (AnchorCapture, AxisBody, StaticState, elevation_of, gravity_of, static_equilibrium,
                                  support_normal_force, support_tangential_force)
+from ..elements.contact_laws import OnsetCapture
 from ..elements.ops import PYTHON_OPS, Ops, ops_for
 
 #: Tree coordinates before the axis bodies: X, Y, phi.
@@ -58,19 +59,29 @@ class PlanarItems:
     keep: list = field(default_factory=list)
     #: support name -> its :class:`~mbs_models.elements.carriage.AnchorCapture` (``anchor = "touchdown"`` spades)
     anchors: dict = field(default_factory=dict)
+    #: support name -> its :class:`~mbs_models.elements.contact_laws.OnsetCapture` (restitution laws: ``v-``)
+    onsets: dict = field(default_factory=dict)
     #: support name -> its carriage-frame point (m), for the captures
     anchor_points: dict = field(default_factory=dict)
 
+    @property
+    def captures(self) -> bool:
+        """Does a support capture anything at the step starts (a touchdown anchor, a restitution law's ``v-``)?"""
+        return bool(self.anchors or self.onsets)
+
     def observe(self, t: float, q, v) -> None:
         """The tree's state (``q``, ``v``: its coordinates in order) at the step start ``t``: the touchdown anchors
-        follow their points while off the ground."""
-        if not self.anchors:
-            return
+        follow their points while off the ground; the restitution laws see the penetration and its rate."""
         X, Y, phi = q[0], q[1], q[2]
         c, s = math.cos(phi), math.sin(phi)
         for support, capture in self.anchors.items():
             rx, ry = self.anchor_points[support]
             capture.observe(t, X + c * rx - s * ry, Y + s * rx + c * ry)
+        for support, capture in self.onsets.items():
+            rx, ry = self.anchor_points[support]
+            height = Y + s * rx + c * ry
+            rate = v[1] + v[2] * (c * rx - s * ry)
+            capture.observe(t, -height, -rate)
 
 
 def axis_bodies(mechanism) -> list[AxisBody]:
@@ -85,10 +96,11 @@ def _rotation_z(angle: float) -> np.ndarray:
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
-def generalized_forces(scene, supports, anchors: dict, loads, q, q_t, t, ops: Ops) -> list:
+def generalized_forces(scene, supports, anchors: dict, loads, q, q_t, t, ops: Ops, lams: dict | None = None) -> list:
     """The ``supports``' and the loads' generalised forces ``[Q_X, Q_Y, Q_phi, Q_1 .. Q_n]`` (N, N, N m, N ...) at
     the tree state ``q``, ``q_t`` and time ``t`` (s), over ``ops`` (module docstring).  ``anchors``: each support's
-    static x (m); ``loads``: ``(tree coordinate, law)`` pairs, ``law(t)`` the force (N, + = rearward) over ``ops``."""
+    static x (m); ``loads``: ``(tree coordinate, law)`` pairs, ``law(t)`` the force (N, + = rearward) over ``ops``;
+    ``lams``: the restitution laws' ``chi / max(v-, floor)`` (s/m) by support name."""
     carriage, theta = scene.carriage, elevation_of(scene)
     X, Y, phi = q[0], q[1], q[2]
     c, s = ops.cos(phi), ops.sin(phi)
@@ -99,7 +111,7 @@ def generalized_forces(scene, supports, anchors: dict, loads, q, q_t, t, ops: Op
         dx, dy = -s * rx - c * ry, c * rx - s * ry           # dP/dphi
         x, y = X + c * rx - s * ry, Y + s * rx + c * ry
         u, v = q_t[0] + q_t[2] * dx, q_t[1] + q_t[2] * dy
-        normal = support_normal_force(support, y, v, ops)
+        normal = support_normal_force(support, y, v, ops, (lams or {}).get(support.name))
         tangential = support_tangential_force(support, normal, x, u, anchors[support.name], ops, y)
         out[0], out[1] = out[0] + tangential, out[1] + normal
         out[2] = out[2] + tangential * dx + normal * dy
@@ -152,9 +164,13 @@ def add_carriage(mbs, mechanism, user_functions: str) -> PlanarItems:
     items = PlanarItems(node=node, tree=tree, static=static,
                         body_coordinate={b.name: 3 + i for i, b in enumerate(bodies)})
     for support in carriage.supports:
+        items.anchor_points[support.name] = support.position
         if support.anchored and support.anchor == "touchdown":
             items.anchors[support.name] = AnchorCapture(static.anchors[support.name])
-            items.anchor_points[support.name] = support.position
+        if support.contact_law.restitution:  # v- of each touch-down; at rest on the ground at t = 0
+            capture = OnsetCapture(support.restitution_factor, support.impact_velocity_floor, 0.0)
+            capture.start(support.static_penetration(static.loads[support.name]), 0.0)
+            items.onsets[support.name] = capture
     _set_tree_forces(mbs, items, mechanism, user_functions, n)
     return items
 
@@ -164,19 +180,24 @@ def _set_tree_forces(mbs, items: PlanarItems, mechanism, user_functions: str, n:
     with state vectors of the tree's size: Exudyn's own conversion records them empty)."""
     ops = ops_for(user_functions)
     loads = [(items.body_coordinate[load.body], load.user_function_law(ops)) for load in mechanism.loads]
-    scene, anchors = mechanism.scene, dict(items.static.anchors)
-    captures = items.anchors
-    if user_functions == "symbolic" and captures:  # the touchdown anchors: variables the pre-step function sets
+    scene, anchors, lams = mechanism.scene, dict(items.static.anchors), {}
+    captures, onsets = items.anchors, items.onsets
+    if user_functions == "symbolic":  # the captured values: variables the pre-step function sets
         import exudyn
         for name, capture in captures.items():
             capture._variable = exudyn.symbolic.Real(f"anchor_{name}_{id(capture)}", capture.anchor)
             anchors[name] = capture._variable
-        captures = {}
+        for name, capture in onsets.items():
+            capture._variable = exudyn.symbolic.Real(f"lam_{name}_{id(capture)}", capture.lam)
+            lams[name] = capture._variable
+        captures, onsets = {}, {}
 
     def user_function(mbs, t, itemNumber, q, q_t):
         for name, capture in captures.items():  # (Python: read at every call)
             anchors[name] = capture.anchor
-        return generalized_forces(scene, scene.carriage.supports, anchors, loads, q, q_t, t, ops)
+        for name, capture in onsets.items():
+            lams[name] = capture.lam
+        return generalized_forces(scene, scene.carriage.supports, anchors, loads, q, q_t, t, ops, lams)
 
     if user_functions == "python":
         function = user_function

@@ -73,6 +73,8 @@ def collect(assembly: Assembly, end_time: float, settings: SolverSettings,
     if assembly.planar is not None:  # the touchdown anchors in force at the samples
         for support, capture in assembly.planar.anchors.items():
             planar[f"support_{support}_anchor"] = capture.anchor_at(time)
+        for support, capture in assembly.planar.onsets.items():  # a restitution law's lam in force
+            planar[f"support_{support}_lam"] = capture.lam_at(time)
     return Samples(time=time, positions={b: values[f"{b}_position"] for b in bodies},
                    velocities={b: values[f"{b}_velocity"] for b in bodies},
                    accelerations={b: values[f"{b}_acceleration"] for b in bodies},

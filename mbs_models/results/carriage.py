@@ -159,7 +159,8 @@ def carriage_output(mechanism, s: Samples, interp: Interpolant, energies=None) -
     for support in carriage.supports:  # the law at the samples' states: the forces the solver applied there
         x, height = geometry.point(q, support.position)
         u, w = geometry.point_velocity(q, v, support.position)
-        normal = np.asarray(support_normal_force(support, height, w, NUMPY_OPS), dtype=float)
+        lam = s.planar.get(f"support_{support.name}_lam")
+        normal = np.asarray(support_normal_force(support, height, w, NUMPY_OPS, lam), dtype=float)
         anchor = s.planar.get(f"support_{support.name}_anchor", static.anchors[support.name])
         tangential = np.asarray(support_tangential_force(support, normal, x, u, anchor, NUMPY_OPS, height),
                                 dtype=float) + 0.0 * normal
@@ -212,7 +213,8 @@ def _planar_energies(mechanism, geometry, static, s, interp, q, v, supports, ene
         stored = support_stored_energy(support, height, x, anchor)
         xn, yn = geometry.point(qn, support.position)
         un, wn = geometry.point_velocity(qn, vn, support.position)
-        normal = support_normal_force(support, yn, wn, NUMPY_OPS)
+        lam = s.planar.get(f"support_{support.name}_lam")
+        normal = support_normal_force(support, yn, wn, NUMPY_OPS, None if lam is None else np.asarray(lam)[1:])
         anchor_n = anchor if np.ndim(anchor) == 0 else np.asarray(anchor)[1:]  # the step's: set at its start
         tangential = support_tangential_force(support, normal, xn, un, anchor_n, NUMPY_OPS, yn)
         power = -(tangential * un + normal * wn)  # into the support

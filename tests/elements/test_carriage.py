@@ -23,8 +23,6 @@ from carriage_scenes import BASE, carriage_scene
     ({"carriage.support.1.position": [0.0, 0.5]}, "carriage.support", "one x"),
     ({"carriage.support.1.name": "spade"}, "carriage.support.1.name", "two supports"),
     ({"carriage.support.0.friction_coefficient": 0.3}, "carriage.support.0.friction_coefficient", "not both"),
-    ({"carriage.support.1.law": "flores", "carriage.support.1.exponent": 1.5, "carriage.support.1.restitution": 0.5,
-      "carriage.support.1.damping": None}, "carriage.support.1.law", "touch-down"),
     ({"carriage.support.1.position": [1.0]}, "carriage.support.1.position", "two numbers"),
     ({"carriage.mass": 0.0}, "carriage.mass", "> 0"),
     ({"carriage.inertia": -1.0}, "carriage.inertia", "> 0"),

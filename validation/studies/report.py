@@ -40,6 +40,7 @@ from mbs_models.outputs import atomic_write_json, atomic_write_text, prepare_out
 from mbs_models.scene import Scene
 from mbs_models.studies.sweep import default_workers, process_pool, run_sweep_jobs, sweep_jobs
 
+from .carriage_report import CARRIAGE_SCENES, carriage_figure, carriage_html, carriage_job, carriage_rows
 from .claims import ClaimEvidence, evaluate_claims
 from .compare import compare
 from .conventions import (CONVENTION_CASES, TREND_GAPS, convention_jobs, convention_rows, engine_job,
@@ -72,6 +73,7 @@ class ReportOptions:
     end_time: float = 10.0
     workers: int | None = None
     studies: bool = True                     # False: no convention study, no calibration (--reproduce-only)
+    carriage: bool = True                    # the shipped towed_howitzer at 0 and 45 degrees, engine and reference
 
     @classmethod
     def reduced(cls, **changes) -> "ReportOptions":
@@ -189,6 +191,8 @@ def compute_report(options: ReportOptions = ReportOptions(), progress: Progress 
     plan.append(("engine vs reference", _comparison_job, [(s,) for s in scenes]))
     if options.studies:
         plan.append(("convention study (reference)", reference_job, [(s,) for s in convention_scenes]))
+    if options.carriage:
+        plan.append(("the gun on its carriage", carriage_job, [(name,) for name, _ in CARRIAGE_SCENES]))
     plan.append(("gap sweeps", run_sweep_jobs, [(chunk,) for chunk in chunks]))
 
     start = time.perf_counter()
@@ -210,6 +214,9 @@ def compute_report(options: ReportOptions = ReportOptions(), progress: Progress 
             stages[name].finish(index, *future.result())
     compute_wall = time.perf_counter() - start
 
+    data["carriage"] = stages["the gun on its carriage"].results if options.carriage else []
+    if options.carriage:
+        timings["the gun on its carriage"] = stages["the gun on its carriage"].seconds
     outputs = stages["engine vs reference"].results
     data["comparisons"] = [case for case, _ in outputs]
     timings["engine vs reference"] = stages["engine vs reference"].seconds
@@ -471,6 +478,8 @@ def figure_builders(data: dict) -> list[tuple[str, Callable]]:
         builders.append((f"energy_m{mass:g}", partial(_energy_figure, data, mass)))
     if data["conventions"]:
         builders.append(("conventions_gap_trend", partial(_convention_figure, data)))
+    if data.get("carriage"):
+        builders.append(("carriage_ground_reactions", partial(carriage_figure, data["carriage"])))
     return builders
 
 
@@ -1125,6 +1134,11 @@ def render_html(data: dict, pngs: dict[str, bytes]) -> str:
                    f"({_e(percent_text(item['relative_difference']))})")
         parts.append(f"<li><b>{_e(item['published'])}</b> &mdash; {numbers}. {_e(bind_units(item['reason']))}</li>")
     parts.append("</ul>")
+    if data.get("carriage"):
+        parts.append(section("carriage", "The gun on its carriage: does it stay on the ground?"))
+        parts.append(carriage_html(carriage_rows(data["carriage"]),
+                                   _img("carriage_ground_reactions", pngs["carriage_ground_reactions"],
+                                        "Ground reactions of the towed howitzer at 0 and 45 degrees (engine)")))
     timing_rows = [[_e(k), f"{v:.1f}&nbsp;s"] for k, v in data["timings"].items()]
     machine = data.get("machine", {})
     parts.append(section("cost", "What this report cost") + _table(["stage", "wall time"], timing_rows)
@@ -1167,6 +1181,7 @@ def results_json(data: dict) -> dict:
         "calibration_table2": data["calibration_table2"],
         "claims": [v.to_dict() for v in data.get("claims", [])],
         "unreproduced": data["unreproduced"],
+        "carriage": [{k: v for k, v in row.items()} for row in carriage_rows(data.get("carriage") or [])],
         "timings": data["timings"],
         "machine": data.get("machine"),
         "provenance": data.get("provenance"),
