@@ -84,20 +84,23 @@ def _f(value, scale: float = 1.0, digits: int = 3) -> str:
         f"{value * scale:.{digits}g}"
 
 
-def carriage_html(rows: list[dict], image: str) -> str:
-    """The section's body (after its heading): what is modelled, the table, the figure (``image``: its HTML)."""
+def carriage_table(rows: list[dict]) -> tuple[list[str], list[list[str]]]:
+    """The section's table: headers and cells (HTML-escaped text)."""
     e = html.escape
-    header = ("<tr><th>scene</th><th>elevation [deg]</th><th>recoil [mm]</th><th>peak resistance [kN]</th>"
-              "<th>stability margin</th><th>lift-off [s]</th><th>supports: static / least / largest [kN]</th>"
-              "<th>engine vs reference</th></tr>")
-    body = []
+    headers = ["scene", "elevation [deg]", "recoil [mm]", "peak resistance [kN]", "stability margin", "lift-off [s]",
+               "supports: static / least / largest [kN]", "engine vs reference"]
+    cells = []
     for r in rows:
         loads = "; ".join(f"{e(n)} {a / 1e3:.1f} / {b / 1e3:.1f} / {c / 1e3:.1f}" for n, (a, b, c) in r["supports"].items())
         check = ("passed" if r["validated"] else "FAILED" if r["validated"] is False else
                  e(f"not run: {r['validation_error']}"))
-        body.append(f"<tr><td>{e(r['scene'])}</td><td>{r['elevation']:g}</td><td>{_f(r['recoil'], 1e3, 4)}</td>"
-                    f"<td>{_f(r['resistance'], 1e-3, 4)}</td><td>{_f(r['margin'], 1, 3)}</td>"
-                    f"<td>{_f(r['lift_off_time'], 1, 4)}</td><td>{loads}</td><td>{check}</td></tr>")
+        cells.append([e(r["scene"]), f"{r['elevation']:g}", _f(r["recoil"], 1e3, 4), _f(r["resistance"], 1e-3, 4),
+                      _f(r["margin"], 1, 3), _f(r["lift_off_time"], 1, 4), loads, check])
+    return headers, cells
+
+
+def carriage_html(rows: list[dict], table: str, image: str) -> str:
+    """The section's body (after its heading): what is modelled, the ``table`` and the figure (``image``), HTML."""
     sentences = []
     for r in rows:
         if r["lift_off_time"] is None:
@@ -106,13 +109,14 @@ def carriage_html(rows: list[dict], image: str) -> str:
         else:
             sentences.append(f"At {r['elevation']:g} degrees a support leaves the ground at {r['lift_off_time']:.4g} s "
                              f"(it rises {r['max_lift'] * 1e3:.2f} mm).")
-    return ("<p>The recoil axis on a planar carriage (DESIGN.md, \"The recoil axis on a carriage\"): the realistic "
-            "scene's recoil hardware on a 4.4 t carriage of two wheels and a spade, the question a recoil designer "
-            "asks after the recoil force: does the gun stay on the ground? Engine: one Exudyn kinematic tree; "
-            "reference: the independent planar equations (<code>validation.reference.planar</code>).</p>"
-            f"<table id='tab-carriage'>{header}{''.join(body)}</table>"
-            f"<p id='carriage-verdict'>{e(' '.join(sentences))}</p>" + image)
+    return ("<p>The recoil axis on a planar carriage that may pitch, lift and slide on its supports (a spade dug in "
+            "at the trail's end, the wheels 5.2 m ahead): the realistic scene's recoil hardware on a 4.4 t carriage, "
+            "and the question a recoil designer asks after the recoil force: does the gun stay on the ground? "
+            "Stability margin: the least load of any support over its static load (1: none unloads; 0: a support "
+            "leaves the ground). Engine: one Exudyn kinematic tree; reference: the independent planar equations "
+            "(<code>validation.reference.planar</code>).</p>"
+            + table + f"<p id='carriage-verdict'>{html.escape(' '.join(sentences))}</p>" + image)
 
 
 __all__ = ["CARRIAGE_SCENES", "CARRIAGE_END_TIME", "carriage_job", "carriage_rows", "carriage_figure",
-           "carriage_html"]
+           "carriage_table", "carriage_html"]

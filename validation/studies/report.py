@@ -40,7 +40,8 @@ from mbs_models.outputs import atomic_write_json, atomic_write_text, prepare_out
 from mbs_models.scene import Scene
 from mbs_models.studies.sweep import default_workers, process_pool, run_sweep_jobs, sweep_jobs
 
-from .carriage_report import CARRIAGE_SCENES, carriage_figure, carriage_html, carriage_job, carriage_rows
+from .carriage_report import (CARRIAGE_SCENES, carriage_figure, carriage_html, carriage_job, carriage_rows,
+                              carriage_table)
 from .claims import ClaimEvidence, evaluate_claims
 from .compare import compare
 from .conventions import (CONVENTION_CASES, TREND_GAPS, convention_jobs, convention_rows, engine_job,
@@ -1136,7 +1137,8 @@ def render_html(data: dict, pngs: dict[str, bytes]) -> str:
     parts.append("</ul>")
     if data.get("carriage"):
         parts.append(section("carriage", "The gun on its carriage: does it stay on the ground?"))
-        parts.append(carriage_html(carriage_rows(data["carriage"]),
+        rows = carriage_rows(data["carriage"])
+        parts.append(carriage_html(rows, _table(*carriage_table(rows), table_id="tab-carriage"),
                                    _img("carriage_ground_reactions", pngs["carriage_ground_reactions"],
                                         "Ground reactions of the towed howitzer at 0 and 45 degrees (engine)")))
     timing_rows = [[_e(k), f"{v:.1f}&nbsp;s"] for k, v in data["timings"].items()]

@@ -250,13 +250,13 @@ def test_report_html_has_every_section_figure_and_table(report_dir):
     page.feed(text)
     ids = set(page.ids)
     for section in ("models", "parameters", "table2", "sweeps", "histories", "contact", "engine-vs-reference",
-                    "conventions", "calibration", "claims", "unreproduced", "cost"):
+                    "conventions", "calibration", "claims", "unreproduced", "carriage", "cost"):
         assert section in ids, section
     for table in ("parameters", "table2", "section22", "engine-vs-reference", "conventions", "calibration-table2",
-                  "claims"):
+                  "claims", "carriage"):
         assert f"tab-{table}" in ids, table
     expected_figures = {"fig4_gap_sweep_model_i", "fig5_gap_sweep_model_ii", "conventions_gap_trend",
-                        "support_force_m1000", "energy_m1000"} | {
+                        "support_force_m1000", "energy_m1000", "carriage_ground_reactions"} | {
         f"{stem}_m{m}" for stem in ("barrel_displacement", "contact_force", "absorber_velocity", "first_impact")
         for m in (100, 500, 1000)}
     assert {f"fig-{name}" for name in expected_figures} <= ids
@@ -280,6 +280,10 @@ def test_results_json_is_complete_and_honest(report_dir):
     assert "Table 2, model (ii), m = 100 kg" in listed and "Table 2, model (ii), m = 500 kg" in listed
     assert all(item["reason"] for item in data["unreproduced"])
     assert len(data["claims"]) == 14
+    carriage = {row["scene"]: row for row in data["carriage"]}  # the gun on its carriage, as computed
+    assert set(carriage) == {"towed_howitzer", "towed_howitzer_45"}
+    assert carriage["towed_howitzer_45"]["lift_off_time"] is None and 0.0 < carriage["towed_howitzer_45"]["margin"] < 1.0
+    assert carriage["towed_howitzer"]["lift_off_time"] is not None and carriage["towed_howitzer"]["margin"] == 0.0
     assert not list(report_dir.glob(".*.tmp")), "no temporary files left behind"
 
 
