@@ -290,8 +290,10 @@ def build_parser() -> argparse.ArgumentParser:
 
     from .plot_sweep import add_parser as add_plot_sweep
     from .optimise import add_parser as add_optimise
+    from .stability import add_parser as add_stability
     add_plot_sweep(sub)
     add_optimise(sub)
+    add_stability(sub, ACCURACY_HELP)
     return parser
 
 
