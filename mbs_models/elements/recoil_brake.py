@@ -9,6 +9,9 @@ Table ``[recoil_brake]`` (version 2)::
     discharge_coefficient = 0.7    # Cd, in (0, 1]
     fluid_density = 870.0          # rho, kg/m^3, > 0
     counter_recoil_orifice_area = 1.0e-4   # optional: another area (number or table) while returning
+    [[recoil_brake.band]]          # optional: a variable-recoil brake, its orifice switched with the elevation
+    up_to = 45.0                   #   degrees: this band acts up to 45 (from the previous band's up_to)
+    orifice_area = [[0.0, 3e-4], [0.6, 1e-4]]   # its area (number or table); counter_recoil_orifice_area too
 
 The piston (area ``A``) pushes oil through the orifice (area ``a``) at ``A v / (Cd a)``; the pressure drop
 ``rho (A v / (Cd a))^2 / 2`` on the piston gives the force
@@ -30,7 +33,7 @@ largest speed the energy allows, ``|v| <= sqrt(2 E0 / M)``: the stiffest the bra
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, ClassVar
 
 from ..errors import SceneError
@@ -103,6 +106,41 @@ def recoil_brake_force(d, rate, brake: "RecoilBrake", ops: Ops = PYTHON_OPS):
 
 
 @dataclass(frozen=True)
+class BrakeBand(Table):
+    """The orifice of a variable-recoil brake within a band of elevations (``[[recoil_brake.band]]``), the way a
+    throttling rod's grooves are switched with elevation (the M109's at 45 degrees, references/recoil-data.md 1.1).
+
+    Attributes
+    ----------
+    up_to: the band's highest elevation, degrees in [-90, 90]: the band acts from the previous band's ``up_to``
+        (exclusive; -90 for the first) to this one (inclusive).
+    orifice_area: the area (m^2) or table of (stroke m, area m^2) pairs in the band.
+    counter_recoil_orifice_area: optional, the area while the barrel returns in the band (default: the brake's).
+    """
+
+    up_to: float
+    orifice_area: Any
+    counter_recoil_orifice_area: Any = None
+    TABLE: ClassVar[str] = "band"
+    SINCE_VERSION: ClassVar[int] = 2
+    RULES: ClassVar = {"up_to": Rule(-90.0, unit="degrees", maximum=90.0)}
+
+    def __post_init__(self):
+        super().__post_init__()
+        for name in AREA_FIELDS:
+            value = getattr(self, name)
+            if value is not None or name == "orifice_area":
+                object.__setattr__(self, name, check_area(f"{self.TABLE}.{name}", value))
+
+    def to_mapping(self) -> dict[str, Any]:
+        out = super().to_mapping()
+        for name in AREA_FIELDS:
+            if isinstance(out.get(name), tuple):
+                out[name] = [list(pair) for pair in out[name]]
+        return out
+
+
+@dataclass(frozen=True)
 class RecoilBrake(Table):
     """Hydraulic recoil brake ``F = rho A^3 v|v| / (2 Cd^2 a(x)^2)`` (module docstring).
 
@@ -114,6 +152,9 @@ class RecoilBrake(Table):
     discharge_coefficient: Cd, in (0, 1].
     fluid_density: rho in kg/m^3 (> 0).
     counter_recoil_orifice_area: optional, the area (number or table) while the barrel returns (v < 0).
+    band: optional ``[[recoil_brake.band]]`` tables, ``up_to`` strictly increasing: at the scene's ``[cradle]``
+        elevation the first band whose ``up_to`` is at least the elevation gives the orifice (and, if it has one,
+        the counter-recoil orifice); above the last band, the areas above.  :meth:`at_elevation`.
     """
 
     piston_area: float
@@ -121,7 +162,9 @@ class RecoilBrake(Table):
     discharge_coefficient: float
     fluid_density: float
     counter_recoil_orifice_area: Any = None
+    band: tuple = ()
     TABLE: ClassVar[str] = "recoil_brake"
+    NESTED_MANY: ClassVar = {"band": BrakeBand}
     ORDER: ClassVar[int] = 50
     SINCE_VERSION: ClassVar[int] = 2
     RULES: ClassVar = {"piston_area": Rule(0.0, strict=True, unit="m^2"),
@@ -134,7 +177,28 @@ class RecoilBrake(Table):
             value = getattr(self, name)
             if value is not None or name == "orifice_area":
                 object.__setattr__(self, name, check_area(f"{self.TABLE}.{name}", value))
+        for i in range(1, len(self.band)):
+            if not self.band[i].up_to > self.band[i - 1].up_to:
+                raise SceneError(f"{self.TABLE}.band.{i}.up_to", f"must exceed the previous band's up_to "
+                                                               f"({self.band[i - 1].up_to:g} degrees): the bands "
+                                                               f"cover the elevations in order, got {self.band[i].up_to:g}")
         self._check_representable()
+        for band in self.band:
+            self._banded(band)._check_representable()
+
+    def _banded(self, band: BrakeBand) -> "RecoilBrake":
+        """This brake with ``band``'s areas (its counter-recoil area, or this brake's) and no bands."""
+        counter = band.counter_recoil_orifice_area
+        return replace(self, orifice_area=band.orifice_area, band=(),
+                       counter_recoil_orifice_area=self.counter_recoil_orifice_area if counter is None else counter)
+
+    def at_elevation(self, elevation: float) -> "RecoilBrake":
+        """The brake as it acts at ``elevation`` (degrees): the first band with ``up_to >= elevation``, else the
+        brake's own areas (no band: itself)."""
+        for band in self.band:
+            if elevation <= band.up_to:
+                return self._banded(band)
+        return self if not self.band else replace(self, band=())
 
     def _check_representable(self) -> None:
         """Every factor of the law ``K(a) = rho A^3 / (2 Cd^2 a^2)`` finite and > 0 as the law computes it, for
@@ -160,7 +224,13 @@ class RecoilBrake(Table):
                           coefficient / ieee_power(max(areas), 2), "kg/m^3", positive=True)
 
     def check_in_scene(self, scene, key: str) -> None:
-        """The brake's largest force at the barrel's free-recoil speed, ``K(a_min) (shots v0)^2``, must be finite."""
+        """The brake's largest force at the barrel's free-recoil speed, ``K(a_min) (shots v0)^2``, must be finite
+        (with the areas of the scene's elevation)."""
+        if self.band:
+            banded = self.at_elevation(_elevation(scene))
+            if banded is not self:
+                banded.check_in_scene(scene, key)
+                return
         area = self.smallest_area()
         keys = {f"{key}.piston_area": self.piston_area, f"{key}.discharge_coefficient": self.discharge_coefficient,
                 f"{key}.fluid_density": self.fluid_density, f"{key}.orifice_area": area, **shot_keys(scene)}
@@ -187,14 +257,22 @@ class RecoilBrake(Table):
         for name in AREA_FIELDS:
             if isinstance(out.get(name), tuple):
                 out[name] = [list(pair) for pair in out[name]]
+        if not self.band:
+            out.pop("band", None)
         return out
 
     def bodies(self, scene, name: str) -> list:
         return []
 
     def connectors(self, scene, name: str) -> list[Connector]:
-        """One brake ground -> barrel."""
-        return [RecoilBrakeConnector(self, scene)]
+        """One brake ground -> barrel (with the areas of the scene's elevation, :meth:`at_elevation`)."""
+        return [RecoilBrakeConnector(self.at_elevation(_elevation(scene)), scene)]
+
+
+def _elevation(scene) -> float:
+    """The scene's ``[cradle]`` elevation (degrees; 0 without a cradle)."""
+    cradle = getattr(scene, "cradle", None)
+    return cradle.elevation if cradle is not None else 0.0
 
 
 class RecoilBrakeConnector(Connector):

@@ -197,11 +197,23 @@ class RecoilBrake(Connector):
         return self.coefficient * rate_bound ** 2 / self.smallest_area(d_bound) ** 2
 
 
+def areas_at(table, elevation: float):
+    """(recoil area, counter-recoil area or None) of a brake table at ``elevation`` (degrees), DESIGN.md: the first
+    ``[[recoil_brake.band]]`` whose ``up_to`` is at least the elevation gives its areas (its counter-recoil area,
+    or the brake's); no such band, the brake's own."""
+    for band in getattr(table, "band", ()) or ():
+        if elevation <= band.up_to:
+            counter = band.counter_recoil_orifice_area
+            return band.orifice_area, table.counter_recoil_orifice_area if counter is None else counter
+    return table.orifice_area, table.counter_recoil_orifice_area
+
+
 def build(builder, key: str, table) -> None:
-    """The brake ground -> barrel."""
-    builder.add_connector(RecoilBrake("recoil_brake", GROUND, BARREL, table.piston_area, table.orifice_area,
-                                      table.discharge_coefficient, table.fluid_density,
-                                      table.counter_recoil_orifice_area))
+    """The brake ground -> barrel, with the areas of the scene's elevation."""
+    cradle = getattr(builder.scene, "cradle", None)
+    recoil, counter = areas_at(table, cradle.elevation if cradle is not None else 0.0)
+    builder.add_connector(RecoilBrake("recoil_brake", GROUND, BARREL, table.piston_area, recoil,
+                                      table.discharge_coefficient, table.fluid_density, counter))
 
 
 __all__ = ["BrakeState", "RecoilBrake", "TABLES", "build", "interpolate", "points_of"]
