@@ -105,6 +105,22 @@ def recoil_brake_force(d, rate, brake: "RecoilBrake", ops: Ops = PYTHON_OPS):
     return brake.coefficient * (rate * ops.absolute(rate)) / (area * area)
 
 
+def _check_area_fields(table) -> None:
+    """Check (and store as floats or tuples of pairs) a table's orifice areas: :func:`check_area` each."""
+    for name in AREA_FIELDS:
+        value = getattr(table, name)
+        if value is not None or name == "orifice_area":
+            object.__setattr__(table, name, check_area(f"{table.TABLE}.{name}", value))
+
+
+def _area_mapping(out: dict[str, Any]) -> dict[str, Any]:
+    """A table's TOML mapping with its area tables as lists of [stroke, area] lists."""
+    for name in AREA_FIELDS:
+        if isinstance(out.get(name), tuple):
+            out[name] = [list(pair) for pair in out[name]]
+    return out
+
+
 @dataclass(frozen=True)
 class BrakeBand(Table):
     """The orifice of a variable-recoil brake within a band of elevations (``[[recoil_brake.band]]``), the way a
@@ -127,16 +143,10 @@ class BrakeBand(Table):
 
     def __post_init__(self):
         super().__post_init__()
-        for name in AREA_FIELDS:
-            value = getattr(self, name)
-            if value is not None or name == "orifice_area":
-                object.__setattr__(self, name, check_area(f"{self.TABLE}.{name}", value))
+        _check_area_fields(self)
 
     def to_mapping(self) -> dict[str, Any]:
-        out = super().to_mapping()
-        for name in AREA_FIELDS:
-            if isinstance(out.get(name), tuple):
-                out[name] = [list(pair) for pair in out[name]]
+        out = _area_mapping(super().to_mapping())
         return out
 
 
@@ -173,10 +183,7 @@ class RecoilBrake(Table):
 
     def __post_init__(self):
         super().__post_init__()
-        for name in AREA_FIELDS:
-            value = getattr(self, name)
-            if value is not None or name == "orifice_area":
-                object.__setattr__(self, name, check_area(f"{self.TABLE}.{name}", value))
+        _check_area_fields(self)
         for i in range(1, len(self.band)):
             if not self.band[i].up_to > self.band[i - 1].up_to:
                 raise SceneError(f"{self.TABLE}.band.{i}.up_to", f"must exceed the previous band's up_to "
@@ -253,10 +260,7 @@ class RecoilBrake(Table):
 
     def to_mapping(self) -> dict[str, Any]:
         """The TOML mapping: tables of pairs as lists of [stroke, area] lists."""
-        out = super().to_mapping()
-        for name in AREA_FIELDS:
-            if isinstance(out.get(name), tuple):
-                out[name] = [list(pair) for pair in out[name]]
+        out = _area_mapping(super().to_mapping())
         if not self.band:
             out.pop("band", None)
         return out
