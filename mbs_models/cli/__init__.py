@@ -170,6 +170,48 @@ def _cmd_contact_laws(args) -> int:
     return EXIT_OK
 
 
+def _design_stable(scene, args) -> int:
+    """``recoil design-brake --stable``: :func:`~mbs_models.studies.stable_brake.design_stable_brake`."""
+    from ..outputs import atomic_write_json, atomic_write_text, check_output_dir, prepare_output_dir
+    from ..scene.io import scene_to_toml
+    from ..scene.overrides import parse_spec
+    from ..studies.stable_brake import design_stable_brake
+
+    elevations = parse_spec(args.elevations, "--elevations")
+    bands = parse_spec(args.bands, "--bands") if args.bands.strip() else []
+    for key, values in (("--elevations", elevations), ("--bands", bands)):
+        if any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in values):
+            raise SceneError(key, f"must be numbers of degrees, got {values!r}")
+    if not 0.0 < args.end_time <= 1e4:
+        raise SceneError("--end-time", f"must be a number of seconds in (0, 10000], got {args.end_time!r}")
+    check_output_dir(args.out)
+    start = time.perf_counter()
+    design = design_stable_brake(scene, elevations, bands, margin=args.margin, max_recoil=args.max_recoil,
+                                 accuracy=args.accuracy, end_time=args.end_time, progress=_progress())
+    out = prepare_output_dir(args.out)
+    atomic_write_text(out / "designed.toml", scene_to_toml(design.scene))
+    data = design.to_dict()
+    atomic_write_json(out / "stable_design.json", data)
+    if args.json:
+        print(json.dumps(data, indent=2, allow_nan=False))
+        return EXIT_OK
+    for band in design.bands:
+        print(f"band up to {band.up_to:g} deg ({', '.join(f'{e:g}' for e in band.elevations)}): recoil "
+              f"{band.achieved * 1e3:.1f} mm (constant resistance, designed for {band.design_length * 1e3:.1f} mm)"
+              + (f"; counter-recoil orifice {band.counter_recoil_orifice_area:.3g} m^2"
+                 if band.counter_recoil_orifice_area is not None else ""))
+        for note in band.notes:
+            print(f"    {note}")
+    for check in design.checks:
+        verdict = "stays down" if check.lift_off_time is None else f"LIFTS at {check.lift_off_time:.3g} s"
+        print(f"  {check.elevation:5g} deg: recoil {check.recoil * 1e3:6.1f} mm, peak resistance "
+              f"{check.peak_resistance / 1e3:7.1f} kN, stability margin {check.stability_margin:.3f}, {verdict}")
+    print(("every support stays on the ground at every elevation" if design.stable else
+           "a support still leaves the ground: see above") + f"; wrote designed.toml and stable_design.json to {out} "
+          f"in {time.perf_counter() - start:.1f} s")
+    return EXIT_OK
+
+
 def _cmd_design_brake(args) -> int:
     from ..outputs import atomic_write_json, atomic_write_text, check_output_dir, prepare_output_dir
     from ..results.plotting import save_figure
@@ -178,6 +220,8 @@ def _cmd_design_brake(args) -> int:
     from ..studies.recoil_peaks import peak_forces
 
     scene = _resolve_scene(args.scene)
+    if args.stable:
+        return _design_stable(scene, args)
     if args.recoil_length is None or not args.recoil_length > 0:
         raise SceneError("--recoil-length", f"must be a length > 0 m, got {args.recoil_length!r}")
     if not 0.0 < args.end_time <= 1e4:
@@ -275,7 +319,22 @@ def build_parser() -> argparse.ArgumentParser:
     design = sub.add_parser("design-brake", help="design the recoil brake's orifice for a constant resistance over "
                                                   "a recoil length, and compare it with a linear damper")
     design.add_argument("scene", help="scene TOML file or shipped scene (a barrel without absorbers, e.g. simplified)")
-    design.add_argument("--recoil-length", type=float, required=True, metavar="L", help="recoil length in m")
+    design.add_argument("--recoil-length", type=float, default=None, metavar="L",
+                        help="recoil length in m (required, but with --stable)")
+    design.add_argument("--stable", action="store_true",
+                        help="design a variable-recoil brake that keeps a carriage scene on the ground at every "
+                             "elevation of --elevations: per band of --bands, the constant-resistance orifice for the "
+                             "shortest stable recoil (at most --max-recoil) and a counter-recoil orifice narrowed "
+                             "until the return keeps 1 - margin of every support's load")
+    design.add_argument("--elevations", default="0:60:5", help="with --stable: elevations in degrees, "
+                                                               "START:STOP:COUNT or a list (default 0:60:5)")
+    design.add_argument("--bands", default="", help="with --stable: band edges (up_to) in degrees, e.g. 45 or "
+                                                    "20,45 (default: one band)")
+    design.add_argument("--margin", type=float, default=0.8,
+                        help="with --stable: the fraction of the closed form's limit the resistance may reach "
+                             "(default 0.8)")
+    design.add_argument("--max-recoil", type=float, default=1.0, help="with --stable: the longest recoil in m the "
+                                                                       "gun's clearance allows (default 1.0)")
     design.add_argument("--out", default="design-brake", help="output directory (default ./design-brake)")
     design.add_argument("--tolerance", type=float, default=None, metavar="TOL",
                         help="how close (m) the simulated recoil length must come to L: the design length is "
