@@ -20,8 +20,10 @@ as it stands.  Equations of motion (:mod:`.kinematics`)::
 * a connector whose mode is a constraint (exact Coulomb friction sticking, a sliding contact) holds its
   relative coordinate's acceleration at 0: ``d'' = -G^T q'' = 0`` with ``G = e_a - e_b`` (the axis
   coordinates of its ends; the ground has none), its force F the multiplier:
-  ``F = -(G^T M^-1 G)^-1 G^T M^-1 Q`` (Q: every other generalised force minus c); all multipliers together
-  solve ``q'' = M^-1 (Q + G F)``, ``G^T q'' = 0``.
+  ``F = -(G^T M^-1 G)^-1 G^T M^-1 Q`` (Q: every other generalised force minus c);
+* a spade sliding on the ground (:mod:`.supports`: p = 0, N = 0) holds its point's ``p'' = 0`` with the share alpha
+  of its force ``D`` (generalised): all multipliers together solve ``q'' = M^-1 (Q + D lam)``, ``R q'' = b`` (rows
+  ``R = G^T``, ``b = 0`` for the connectors).
 
 Dissipated powers: the axis connectors' as in 1-D (a constraint's ``(F - F_c(d)) d'``), the supports'
 (:meth:`.supports.Support.dissipated_power`); the work rate of a load is ``Q_load . q'``.
@@ -34,7 +36,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..model import Evaluation, Mode, Model
-from ..terms.contact_laws import OFF, ContactMode
+from ..terms.contact_laws import OFF, STICK, ContactMode
 from .kinematics import Geometry
 from .supports import Support, SupportMode
 
@@ -62,7 +64,8 @@ class PlanarMode(Mode):
 class PlanarEvaluation(Evaluation):
     """:class:`~validation.reference.model.Evaluation` (forces, axis accelerations, support force S) plus the
     generalised accelerations ``qdd`` (n rows), each support's ``normal`` and ``tangential`` force (N) and
-    dissipated power (W), the axis connectors' ``powers`` and the loads' work rates (W)."""
+    dissipated power (W), the axis connectors' ``powers``, the loads' work rates (W) and the share alpha of every
+    spade sliding on the ground (``shares``, by support index)."""
 
     qdd: object = None
     normal: list = field(default_factory=list)
@@ -70,6 +73,7 @@ class PlanarEvaluation(Evaluation):
     support_powers: list = field(default_factory=list)
     powers: list = field(default_factory=list)
     work_rates: list = field(default_factory=list)
+    shares: dict = field(default_factory=dict)
 
 
 class PlanarModel:
@@ -144,11 +148,12 @@ class PlanarModel:
         return out
 
     # ------------------------------------------------------------------ the dynamics
-    def evaluate(self, mode: PlanarMode, y, omit: int | None = None, t=None,
-                 free_support: int | None = None) -> PlanarEvaluation:
+    def evaluate(self, mode: PlanarMode, y, omit: int | None = None, t=None, free_support: int | None = None,
+                 free_share: float = 0.0) -> PlanarEvaluation:
         """Everything at a state ``y`` (n,) or a batch (n, N) in ``mode`` (module docstring): floats for a state,
         arrays for a batch.  ``omit``: leave out axis connector ``omit`` (its force, or its constraint);
-        ``free_support``: leave out that support's forces (normal, and tangential: its friction or spade)."""
+        ``free_support``: leave out that support's forces (normal, and tangential: its friction or spade), but for the
+        share ``free_share`` of a spade's force (1: all of it, with N = 0)."""
         y = np.asarray(y, dtype=float)
         batch = y.ndim == 2
         shape = y.shape[1:]                                       # () for a state, (N,) for a batch
@@ -162,6 +167,7 @@ class PlanarModel:
             fg = np.broadcast_to(np.asarray(fg, dtype=float), shape).copy()
         X, Yc, phi, dX, dY, dphi = self.carriage(y)
         xs, vs = self.axis_coordinates(y)
+        shares = {}
         Q = g.gravity_forces(phi, xs) - g.velocity_terms(phi, xs, dphi, vs)
         for i in range(nb):
             Q[3 + i] += f[i]
@@ -176,13 +182,18 @@ class PlanarModel:
                 Q += QL
                 work_rates.append(np.sum(QL * qd, axis=0))
         normal, tangential, support_powers = [], [], []
+        sliding = []   # the spades sliding on the ground: (support index, x_s, u_s)
         for k, s in enumerate(self.supports):
             smode = mode.supports[k]
             if k == free_support:
-                smode = SupportMode(ContactMode(OFF), smode.slip, smode.anchor)
+                smode = SupportMode(ContactMode(STICK if free_share else OFF), smode.slip, smode.anchor)
             x_s, y_s, u_s, w_s = s.motion(g, (X, Yc, phi, dX, dY, dphi))
             Nn = s.normal(smode, -y_s, -w_s)
-            T = s.tangential(smode, Nn, x_s, u_s)
+            if smode.sliding and k != free_support:
+                T = 0.0 * u_s  # its share of the spade's force is a multiplier, below
+                sliding.append((k, smode, x_s, u_s))
+            else:
+                T = s.tangential(smode, Nn, x_s, u_s, share=free_share)
             Q[0] += T
             Q[1] += Nn
             Q[2] += g.point_force(phi, s.point, T, Nn)
@@ -193,22 +204,37 @@ class PlanarModel:
         if batch:
             M, Q = np.moveaxis(M, -1, 0), np.moveaxis(Q, -1, 0)   # (N, n, n), (N, n)
         held = [j for j in self.constraints(axis_mode) if j != omit]
-        if not held:
+        if not held and not sliding:
             qdd = np.linalg.solve(M, Q[..., None])[..., 0]
         else:
-            # multipliers F: qdd = M^-1 (Q + G F) with G^T qdd = 0 (G: the held connectors' axis coordinates)
-            G = np.zeros(M.shape[:-2] + (g.n, len(held)))
+            # multipliers lam: qdd = M^-1 (Q + D lam) with R qdd = b (the axis constraints: D = G, R = G^T, b = 0;
+            # a sliding spade: D its force's generalised force, R qdd = b its point's p'' = 0)
+            m = len(held) + len(sliding)
+            D = np.zeros(M.shape[:-2] + (g.n, m))
+            R = np.zeros(M.shape[:-2] + (m, g.n))
+            b = np.zeros(M.shape[:-2] + (m,))
             for col, j in enumerate(held):
                 c = self.axis.connectors[j]
                 if c.body_a is not None:
-                    G[..., 3 + c.body_a, col] += 1.0
+                    D[..., 3 + c.body_a, col] += 1.0
                 if c.body_b is not None:
-                    G[..., 3 + c.body_b, col] -= 1.0
-            R = np.swapaxes(G, -1, -2)
-            MG = np.linalg.solve(M, G)                                          # (..., n, m)
+                    D[..., 3 + c.body_b, col] -= 1.0
+                R[..., col, :] = D[..., :, col]
+            cphi, sphi = np.cos(phi), np.sin(phi)
+            for col, (k, smode, x_s, u_s) in enumerate(sliding, start=len(held)):
+                support = self.supports[k]
+                rx, ry = support.point
+                full = support.spade_force(smode.anchor, x_s, u_s)
+                D[..., 0, col] = full
+                D[..., 2, col] = g.point_force(phi, support.point, full, 0.0)
+                # p'' = -(Y'' + phi'' (c rx - s ry)) + phi'^2 (s rx + c ry) = 0
+                R[..., col, 1] = -1.0
+                R[..., col, 2] = -(cphi * rx - sphi * ry)
+                b[..., col] = -dphi * dphi * (sphi * rx + cphi * ry)
+            MD = np.linalg.solve(M, D)                                          # (..., n, m)
             MQ = np.linalg.solve(M, Q[..., None])                               # (..., n, 1)
-            lam = np.linalg.solve(R @ MG, -(R @ MQ))                            # (..., m, 1)
-            qdd = (MQ + MG @ lam)[..., 0]
+            lam = np.linalg.solve(R @ MD, b[..., None] - R @ MQ)                # (..., m, 1)
+            qdd = (MQ + MD @ lam)[..., 0]
             for col, j in enumerate(held):
                 c = self.axis.connectors[j]
                 F = lam[..., col, 0] if batch else float(lam[col, 0])
@@ -219,6 +245,10 @@ class PlanarModel:
                           else c.static_force(float(d)))
                 if c.dissipates:
                     powers[self.axis.dissipating.index(c)] = (F - static) * rate
+            for col, (k, smode, x_s, u_s) in enumerate(sliding, start=len(held)):
+                share = lam[..., col, 0] if batch else float(lam[col, 0])
+                shares[k] = share
+                tangential[k] = share * self.supports[k].spade_force(smode.anchor, x_s, u_s)
         support_powers = [s.dissipated_power(smode, p, rate, Nn, T, u_s, x_s)
                           for s, T, (smode, p, rate, Nn, u_s, x_s) in zip(self.supports, tangential, support_powers)]
         if batch:
@@ -232,7 +262,7 @@ class PlanarModel:
                 [float(v) for v in group] for group in (normal, tangential, support_powers, powers, work_rates))
         return PlanarEvaluation(forces, [qdd[3 + i] for i in range(nb)], fg, qdd=qdd, normal=normal,
                                 tangential=tangential, support_powers=support_powers, powers=powers,
-                                work_rates=work_rates)
+                                work_rates=work_rates, shares=shares)
 
     def rhs(self, mode: PlanarMode):
         """``f(t, y) -> dy/dt`` in ``mode`` (state layout: module docstring)."""

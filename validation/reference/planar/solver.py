@@ -55,9 +55,9 @@ def _anchor_jumps(model: PlanarModel, previous, mode, y: np.ndarray) -> np.ndarr
     y = y.copy()
     for k, s in enumerate(model.supports):
         before, after = previous.supports[k], mode.supports[k]
-        if s.anchored and before.in_ground != after.in_ground:
+        if s.anchored and before.spring_stored != after.spring_stored:
             x_s = model.support_motion(s)(y)[0]
-            if before.in_ground:
+            if before.spring_stored:
                 y[model.support_slot + k] += float(s.anchor_energy(before.anchor, x_s))
             else:
                 y[model.support_slot + k] -= float(s.anchor_energy(after.anchor, x_s))

@@ -15,21 +15,27 @@ height ``y_s``, horizontal velocity ``u_s``.  Its force on the carriage, ``(T, N
   (``anchor = "touchdown"``); or none (frictionless).
 
 Discrete state (:class:`SupportMode`): the normal contact's :class:`~..terms.contact_laws.ContactMode` (``on``:
-the law acts; ``off`` and ``penetrated``: clipped; ``penetrated``: ``p > 0``, a spade holds), the friction branch
-``slip`` (-1, 0, +1) and a spade's ``anchor`` x_s0.  Switching surfaces (events): ``p = 0`` (touch / leave the
-ground: the spade's force switches there), the clipping surface while penetrated (``1 + a p' = 0`` or
-``p + (c/k) p' = 0``: N reaches 0; nothing else switches there) and ``u_s = +-v_reg`` (the friction's branches).
+the law acts; ``off`` and ``penetrated``: clipped; ``penetrated``: ``p > 0``, a spade holds; ``stick``: a spade
+sliding on the ground, below), the friction branch ``slip`` (-1, 0, +1) and a spade's ``anchor`` x_s0.  Switching
+surfaces (events): ``p = 0`` (touch / leave the ground: the spade's force switches there), the clipping surface
+while penetrated (``1 + a p' = 0`` or ``p + (c/k) p' = 0``: N reaches 0; nothing else switches there) and
+``u_s = +-v_reg`` (the friction's branches).
 
-The spade's force switches on ``p = 0`` only: the point crosses it with ``p' != 0`` (a touch-down or a leave),
-or the segment ends there and the restart classifies by the side the motion heads to (as every contact).  A motion
-held on ``p = 0`` by the spade's force (pushed out while it holds, pressed in while it does not) would chatter
-there; the solve then stops with the 1-D solver's ReferenceSolveError (stuck, or chattering: too many segments), never with a
-wrong answer.
+A spade's force switches on ``p = 0``, so that surface can hold the motion from both sides (Filippov): in the
+ground the spade's force lifts the point out (``p'' < 0`` with N = 0 at p = p' = 0), off it the weight presses it
+back (``p'' > 0``): a spade landing away from its anchor (``rest``) with its spring stretched.  Then the spade
+*slides on the ground* (phase ``stick``): ``p = 0``, ``N = 0`` and its horizontal force is the share ``alpha``
+(0 <= alpha <= 1) of its force in the ground that keeps ``p'' = 0`` (a multiplier of the planar equations,
+:mod:`.model`); it ends where alpha reaches 0 (the point leaves the ground) or 1 (it digs in), events ``a0`` and
+``a1``.  At a restart on the ground (``|p|`` below :data:`GROUND_POSITION` and ``|p'|`` below
+:data:`GROUND_TIME` times ``|p''|`` on either side: it would cross and come back within that time) the spade slides
+iff ``p'' > 0`` off the ground and ``p'' < 0`` in it.
 
-Energy: stored ``k max(p, 0)^(n+1) / (n+1)`` plus, for a spade in the ground, ``k_h (x_s - x_s0)^2 / 2``;
-dissipated power ``(N - k p^n) p' - T u_s`` minus the spade spring's rate.  When a spade leaves the ground its
-spring's energy leaves the balance at once (and one anchored at rest takes its energy back at a touch-down away
-from its anchor): the solver adds it to the support's dissipated energy there (:meth:`Support.anchor_energy`).
+Energy: stored ``k max(p, 0)^(n+1) / (n+1)`` plus, for a spade in the ground or sliding on it,
+``k_h (x_s - x_s0)^2 / 2``; dissipated power ``(N - k p^n) p' - T u_s`` minus the spade spring's rate.  When a
+spade leaves the ground its spring's energy leaves the balance at once (and one anchored at rest takes its energy
+back at a touch-down away from its anchor): the solver adds it to the support's dissipated energy there
+(:meth:`Support.anchor_energy`).
 """
 
 from __future__ import annotations
@@ -38,8 +44,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..terms.contact_laws import OFF, ON, ContactMode, Law
+from ..terms.contact_laws import OFF, ON, STICK, ContactMode, Law
 from ..switching import TOL_POS, TOL_S, heading
+
+#: A point within this distance (m) of the ground, and whose rate would carry it across and back within
+#: ``GROUND_TIME`` (s) on either side, is on the ground: there a spade whose force pushes it out slides on it.
+GROUND_POSITION, GROUND_TIME = 1e-12, 1e-9
 
 
 @dataclass(frozen=True)
@@ -59,9 +69,18 @@ class SupportMode:
 
     @property
     def in_ground(self) -> bool:
-        """Is the point in the ground (p > 0; its normal law acting or clipped): a spade holds, its spring's energy
-        is stored."""
+        """Is the point in the ground (p > 0; its normal law acting or clipped): a spade holds."""
         return self.contact.phase == ON or self.contact.penetrated
+
+    @property
+    def sliding(self) -> bool:
+        """Does a spade slide on the ground (p = 0, N = 0, a share of its force: module docstring)?"""
+        return self.contact.phase == STICK
+
+    @property
+    def spring_stored(self) -> bool:
+        """Is a spade's spring energy stored (in the ground or sliding on it)?"""
+        return self.in_ground or self.sliding
 
 
 class Support:
@@ -115,10 +134,13 @@ class Support:
         """``-(k_h (x - x0) + c_h u)`` (N): a spade's horizontal force in the ground, anchored at x0 = ``anchor``."""
         return -(self.horizontal_stiffness * (x - anchor) + self.horizontal_damping * u)
 
-    def tangential(self, mode: SupportMode, normal, x, u):
-        """T (N) in ``mode`` from N (N), the point's x (m) and horizontal velocity u (m/s)."""
+    def tangential(self, mode: SupportMode, normal, x, u, share=0.0):
+        """T (N) in ``mode`` from N (N), the point's x (m) and horizontal velocity u (m/s); a sliding spade's
+        ``share`` (alpha) of its force."""
         if self.anchored:
-            return self.spade_force(mode.anchor, x, u) if mode.in_ground else 0.0 * u
+            if mode.in_ground:
+                return self.spade_force(mode.anchor, x, u)
+            return share * self.spade_force(mode.anchor, x, u) if mode.sliding else 0.0 * u
         if self.friction == 0.0:
             return 0.0 * u
         if mode.slip:
@@ -126,10 +148,10 @@ class Support:
         return -self.friction * normal * u / self.friction_velocity
 
     def stored_energy(self, mode: SupportMode | None, p, x):
-        """``k max(p, 0)^(n+1) / (n+1)`` plus a spade's ``k_h (x - x0)^2 / 2`` while in the ground (J)."""
+        """``k max(p, 0)^(n+1) / (n+1)`` plus a spade's ``k_h (x - x0)^2 / 2`` while in the ground or sliding (J)."""
         n = self.law.exponent
         out = self.law.stiffness * np.maximum(p, 0.0) ** (n + 1.0) / (n + 1.0)
-        if self.anchored and mode is not None and mode.in_ground:
+        if self.anchored and mode is not None and mode.spring_stored:
             out = out + self.anchor_energy(mode.anchor, x)
         return out
 
@@ -143,7 +165,7 @@ class Support:
         if mode.contact.penetrated or mode.contact.phase == ON:
             out = (normal - self.elastic(p)) * rate
         out = out - tangential * u
-        if self.anchored and mode.in_ground:
+        if self.anchored and mode.spring_stored:
             out = out - self.horizontal_stiffness * (x - mode.anchor) * u
         return out
 
@@ -190,34 +212,44 @@ class Support:
         return 0
 
     def _anchor(self, previous: SupportMode | None, in_ground: bool, x: float) -> float | None:
-        """x_s0 after a restart: ``touchdown`` moves it to the point's x where it enters the ground."""
+        """x_s0 after a restart: ``touchdown`` moves it to the point's x where it touches the ground (enters it or
+        slides on it)."""
         if not self.anchored:
             return None
         before = self.anchor if previous is None else previous.anchor
-        entering = in_ground and previous is not None and not previous.in_ground
+        entering = in_ground and previous is not None and not previous.spring_stored
         return float(x) if self.anchor_rule == "touchdown" and entering else before
 
     def classify(self, p: float, rate: float, free: float, u: float, du: float, hints: dict,
-                 previous: SupportMode | None, x: float = 0.0) -> SupportMode:
+                 previous: SupportMode | None, x: float = 0.0, free_holding: float | None = None) -> SupportMode:
         """The state at a restart from ``p``, ``p'``, the free ``p''`` (this support's forces left out), the
-        point's x, u and du/dt, the hints of the event that stopped the segment (``p``, ``s``, ``u+``, ``u-``: True
-        if crossed upwards) and the previous state."""
+        point's x, u and du/dt, the hints of the event that stopped the segment (``p``, ``s``, ``u+``, ``u-``,
+        ``a0``, ``a1``: True if crossed upwards) and the previous state; ``free_holding``: a spade's ``p''`` with
+        N = 0 and its whole force (whether it slides on the ground, module docstring)."""
         slip = self._branch(u, du, hints)
-        if not (hints["p"] if "p" in hints else heading(p, rate, free)):
+        if "a0" in hints:      # a sliding spade's share fell to 0: the point leaves the ground
+            return SupportMode(ContactMode(OFF), slip, self._anchor(previous, False, x))
+        if (self.anchored and free_holding is not None and "a1" not in hints and free > 0.0 > free_holding
+                and abs(p) <= GROUND_POSITION and abs(rate) <= GROUND_TIME * min(free, -free_holding)):
+            return SupportMode(ContactMode(STICK), slip, self._anchor(previous, True, x))
+        entering = "a1" in hints or (hints["p"] if "p" in hints else heading(p, rate, free))
+        if not entering:
             return SupportMode(ContactMode(OFF), slip, self._anchor(previous, False, x))
         anchor = self._anchor(previous, True, x)
         factor, onset = self._episode(rate, None if previous is None else previous.contact)
         acting = SupportMode(ContactMode(ON, True, False, factor, onset), slip, anchor)
-        if not self.law.has_clipping_surface:
+        if not self.law.has_clipping_surface or "a1" in hints:
             return acting
         tol = TOL_POS if self.law.kelvin_voigt else TOL_S
         value = self.surface(p, rate, factor)
         above = hints["s"] if "s" in hints else heading(value, self.surface_rate(rate, free, factor), tol=tol)
         return acting if above else SupportMode(ContactMode(OFF, True, True, factor, onset), slip, anchor)
 
-    def events(self, mode: SupportMode, motion) -> list[tuple]:
+    def events(self, mode: SupportMode, motion, share=None) -> list[tuple]:
         """``(event, g(t, y), positive)`` of the surfaces watched in ``mode``; ``motion(y)`` gives
-        ``(x_s, y_s, u_s, w_s)`` of a planar state or batch."""
+        ``(x_s, y_s, u_s, w_s)`` of a planar state or batch, ``share(t, y)`` a sliding spade's alpha."""
+        if mode.sliding:
+            return [("a0", share, True), ("a1", lambda t, y: share(t, y) - 1.0, False)]
         items = [("p", lambda t, y: -motion(y)[1], mode.contact.penetrated)]
         if mode.contact.penetrated and self.law.has_clipping_surface:
             factor, surface = mode.contact.factor, self.surface

@@ -11,9 +11,10 @@ answering what the connectors ask while they classify themselves:
 * ``force_function(c)``: c's force in the classified mode (a constraint's multiplier included).
 
 The supports are classified last (:meth:`.supports.Support.classify`) from their penetration, its rate and
-its free acceleration (their own forces left out), the point's x, horizontal velocity and acceleration and the
-hints ``support.NAME.<event>`` of the event that stopped the previous segment; their events are added to the
-connectors'.
+its free acceleration (their own forces left out; for a spade also with its whole horizontal force and N = 0:
+whether it slides on the ground), the point's x, horizontal velocity and acceleration and the hints
+``support.NAME.<event>`` of the event that stopped the previous segment; their events are added to the
+connectors' (a sliding spade's share alpha reaching 0 or 1).
 """
 
 from __future__ import annotations
@@ -82,14 +83,19 @@ class PlanarRestart(Restart):
         dy = self.planar.rhs(self._planar_mode(self.states))(self.t, self.y)
         du = self._rate(lambda y: motion(y)[2], dy)
         free = -self._rate(lambda y: motion(y)[3], self._derivative(free_support=k))
+        free_holding = (-self._rate(lambda y: motion(y)[3], self._derivative(free_support=k, free_share=1.0))
+                        if support.anchored else None)
         prefix = support_prefix(support)
         hints = {name[len(prefix):]: v for name, v in self._hints.items() if name.startswith(prefix)}
         previous = None if self.previous is None else self.previous.supports[k]
-        return support.classify(-float(height), -float(rise), free, float(u), du, hints, previous, float(x))
+        return support.classify(-float(height), -float(rise), free, float(u), du, hints, previous, float(x),
+                                free_holding)
 
-    def _derivative(self, free_support=None):
-        """dy/dt at the restart with the current states (``free_support``: that support's forces left out)."""
-        ev = self.planar.evaluate(self._planar_mode(self.states), self.y, t=self.t, free_support=free_support)
+    def _derivative(self, free_support=None, free_share=0.0):
+        """dy/dt at the restart with the current states (``free_support``: that support's forces left out, a
+        spade's but for ``free_share`` of it)."""
+        ev = self.planar.evaluate(self._planar_mode(self.states), self.y, t=self.t, free_support=free_support,
+                                  free_share=free_share)
         planar, slot = self.planar, self.planar.carriage_slot
         dy = np.zeros(planar.n_states)
         dy[slot:slot + 3] = self.y[slot + 3:slot + 6]
@@ -97,6 +103,11 @@ class PlanarRestart(Restart):
         for i in range(planar.axis.n_bodies):
             dy[2 * i], dy[2 * i + 1] = self.y[2 * i + 1], ev.qdd[3 + i]
         return dy
+
+    def _share_function(self, k: int):
+        """``(t, y) -> alpha`` of support k sliding in the classified mode (a state or a batch)."""
+        planar, mode = self.planar, self.mode
+        return lambda t, y: planar.evaluate(mode, y, t=t).shares[k]
 
     def _rate(self, g, dy) -> float:
         """d/dt of ``g(y)`` along ``dy`` at the restart (central difference over +-1 ns)."""
@@ -107,7 +118,7 @@ class PlanarRestart(Restart):
         funcs, names = super().events()
         for k, s in enumerate(self.planar.supports):
             motion = self.planar.support_motion(s)
-            for event, g, positive in s.events(self.mode.supports[k], motion):
+            for event, g, positive in s.events(self.mode.supports[k], motion, self._share_function(k)):
                 value = float(g(self.t, self.y))
                 rate = self._rate(lambda y: g(self.t, y), self.dy)
                 noise = 1e-15 * max(1.0, abs(value))

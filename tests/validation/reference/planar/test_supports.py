@@ -112,3 +112,28 @@ def test_a_spade_clipped_in_the_ground_is_not_a_switch_of_its_force():
     names = [e[0] for e in s.events(below, lambda y: (0.0, 0.0, 0.0, 0.0))]
     assert names == ["p", "s"]
     assert s.tangential(below, 0.0, 1e-5, 0.0) == s.tangential(above, 0.0, 1e-5, 0.0) == pytest.approx(-2.0e3)
+
+
+def test_a_spade_on_the_ground_slides_where_both_sides_push_onto_it():
+    """At p = p' = 0 (within GROUND_POSITION, and p' within GROUND_TIME of the accelerations): off the ground
+    p'' = 6.5 > 0 (the weight presses it in), in it with N = 0 p'' = -5.3 < 0 (its spring lifts it out): it slides
+    (N = 0, a share of its force).  Where both agree it goes their way; the events of the share (a0, a1) end the
+    slide and no p event is watched on it."""
+    s = Support(table(horizontal_stiffness=2.0e8, horizontal_damping=1.0e6), anchor=0.0)
+    off = SupportMode(ContactMode(OFF), 0, 0.0)
+    slide = s.classify(6.6e-15, -1.6e-12, 6.5, 0.0, 0.0, {"p": True}, off, x=1e-5, free_holding=-5.3)
+    assert slide.sliding and not slide.holding and not slide.in_ground and slide.spring_stored
+    assert slide.anchor == 0.0                                          # rest: the anchor stays
+    assert s.classify(6.6e-15, -1.6e-12, 6.5, 0.0, 0.0, {"p": True}, off, x=1e-5, free_holding=2.0).holding
+    assert not s.classify(6.6e-15, -1.6e-12, -1.0, 0.0, 0.0, {}, off, x=1e-5, free_holding=-5.3).spring_stored
+    # crossing with a rate that carries it across in more than GROUND_TIME: a touch-down, not a slide
+    assert s.classify(0.0, 1e-3, 6.5, 0.0, 0.0, {"p": True}, off, x=1e-5, free_holding=-5.3).in_ground
+    assert s.classify(0.0, 0.0, 6.5, 0.0, 0.0, {"a1": True}, slide, x=1e-5, free_holding=-5.3).holding
+    assert not s.classify(0.0, 0.0, 6.5, 0.0, 0.0, {"a0": False}, slide, x=1e-5, free_holding=-5.3).spring_stored
+    names = [e[0] for e in s.events(slide, lambda y: (0.0, 0.0, 0.0, 0.0), lambda t, y: 0.5)]
+    assert names == ["a0", "a1"]
+    assert s.tangential(slide, 0.0, 1e-5, 0.0, share=0.25) == pytest.approx(-0.25 * 2.0e8 * 1e-5)
+    assert s.stored_energy(slide, 0.0, 1e-5) == pytest.approx(0.5 * 2.0e8 * 1e-10)
+    # touchdown: a slide is a touch-down too
+    down = Support(table(horizontal_stiffness=2.0e8, anchor="touchdown"), anchor=0.0)
+    assert down.classify(6.6e-15, -1.6e-12, 6.5, 0.0, 0.0, {"p": True}, off, x=1e-5, free_holding=-5.3).anchor == 1e-5
