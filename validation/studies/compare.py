@@ -29,9 +29,10 @@ from ..reference import ReferenceResult
 #: The carriage's tolerances per preset (scenes with [carriage]; ``stability_margin`` and ``lift_off_time`` compare
 #: absolutely, 1 and s, below 1).  Measured on the shipped ``towed_howitzer`` and ``towed_howitzer_45`` (3 s), the
 #: test scenes of ``tests/carriage_scenes.py`` and ``tests/planar_scenes.py`` and the hard cases grazing, jump and
-#: slipping of ``tests/engine/test_planar_hard_cases.py`` (1-2 s): the largest error over those scenes ->
-#: the tolerance.  The presets' claims (``mbs_models/engine/accuracy.py``: 1e-4 / 1e-7 / 1e-9 on a metric) hold for
-#: quantities the engine refines; the carriage's extremes (``max_carriage_pitch``, ``max_lift``,
+#: slipping of ``tests/engine/test_planar_hard_cases.py`` (1-2 s), the shipped ones also over 10 s (``recoil
+#: validate``'s default): the largest error over those scenes -> the tolerance, about 3x above it (a sampled
+#: extreme's error varies with where the steps fall).  The presets' claims (``mbs_models/engine/accuracy.py``:
+#: 1e-4 / 1e-7 / 1e-9 on a metric) hold for quantities the engine refines; the carriage's extremes (``max_carriage_pitch``, ``max_lift``,
 #: ``max_carriage_displacement``, the supports' least and largest load, hence ``stability_margin``) and
 #: ``lift_off_time`` are taken at the engine's output samples, not refined (DESIGN.md), so their error is the
 #: sampling's, larger than the claim at ``standard`` and ``reference``:
@@ -40,11 +41,11 @@ from ..reference import ReferenceResult
 #: quantity                   draft: measured -> tol      standard                    reference
 #: =========================  ==========================  ==========================  ==========================
 #: max_carriage_pitch         7.4e-5 -> 3e-4              3.3e-5 -> 1e-4              2.2e-6 -> 1e-5
-#: max_lift                   6.5e-5 -> 1e-3 (standard's) 1.8e-4 -> 1e-3              5.0e-6 -> 3e-5
-#: lift_off_time (s)          3.4e-4 -> 1e-3              3.8e-5 -> 2e-4              4.1e-6 -> 2e-5
+#: max_lift                   1.1e-3 -> 3e-3              3.0e-4 -> 1e-3              5.7e-6 -> 3e-5
+#: lift_off_time (s)          3.4e-4 -> 1e-3              3.8e-5 -> 2e-4              4.3e-6 -> 2e-5
 #: max_carriage_displacement  1.8e-3 -> 5e-3              8.0e-5 -> 3e-4              2.0e-5 -> 1e-4
-#: stability_margin           3.9e-4 -> 2e-3              4.9e-5 -> 2e-4              4.5e-6 -> 2e-5
-#: support_normal_force       5.6e-4 -> 2e-3              4.9e-5 -> 2e-4              4.5e-6 -> 2e-5
+#: stability_margin           3.9e-4 -> 2e-3              5.9e-5 -> 2e-4              8.7e-6 -> 3e-5
+#: support_normal_force       8.5e-4 -> 3e-3              5.9e-5 -> 2e-4              8.7e-6 -> 3e-5
 #: carriage_history           4.5e-4 -> 1e-3              4.5e-4 -> 1e-3              4.5e-4 -> 1e-3
 #: =========================  ==========================  ==========================  ==========================
 #:
@@ -54,13 +55,13 @@ from ..reference import ReferenceResult
 #: at ``v_reg`` while stuck; without the cradle friction the same scene agrees to 6e-10).  On the scenes without
 #: cradle friction the histories agree to 1.3e-5 / 1.7e-7 / 1e-9 at draft / standard / reference.
 CARRIAGE_TOLERANCES = {
-    "draft": {"max_carriage_pitch": 3e-4, "max_lift": 1e-3, "lift_off_time": 1e-3, "max_carriage_displacement": 5e-3,
-              "stability_margin": 2e-3, "support_normal_force": 2e-3, "carriage_history": 1e-3},
+    "draft": {"max_carriage_pitch": 3e-4, "max_lift": 3e-3, "lift_off_time": 1e-3, "max_carriage_displacement": 5e-3,
+              "stability_margin": 2e-3, "support_normal_force": 3e-3, "carriage_history": 1e-3},
     "standard": {"max_carriage_pitch": 1e-4, "max_lift": 1e-3, "lift_off_time": 2e-4,
                  "max_carriage_displacement": 3e-4, "stability_margin": 2e-4, "support_normal_force": 2e-4,
                  "carriage_history": 1e-3},
     "reference": {"max_carriage_pitch": 1e-5, "max_lift": 3e-5, "lift_off_time": 2e-5,
-                  "max_carriage_displacement": 1e-4, "stability_margin": 2e-5, "support_normal_force": 2e-5,
+                  "max_carriage_displacement": 1e-4, "stability_margin": 3e-5, "support_normal_force": 3e-5,
                   "carriage_history": 1e-3},
 }
 #: Relative tolerances of the metrics at the ``standard`` preset (validation issue); the carriage's are
