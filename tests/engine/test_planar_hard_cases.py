@@ -13,49 +13,14 @@ import numpy as np
 import pytest
 
 import mbs_models as m
-from mbs_models.elements.carriage import AxisBody, static_equilibrium
 from mbs_models.scene.io import load_scene, scene_from_dict, scene_to_dict
 
-from carriage_scenes import BASE, SCENES_DIR, carriage_scene
+from carriage_scenes import SCENES_DIR, carriage_scene, grazing_scene, jump_scene, slipping_scene
 
 PRESETS = ("draft", "standard", "reference")
 
 
-def _grazing_scene():
-    """BASE with a third support under the carriage's middle placed exactly at the ground in the static
-    equilibrium of the other two (height 0, no load): the pitching after the shot makes it touch and leave."""
-    two = carriage_scene()
-    static = static_equilibrium(two.carriage, 0.0, 9.81, [AxisBody("barrel", 1000.0)])
-    x = 1.4
-    y = -(static.height + x * math.sin(static.pitch)) / math.cos(static.pitch)
-    data = scene_to_dict(two)
-    data["carriage"]["support"].append({"name": "skid", "position": [x, y], "law": "kelvin-voigt",
-                                        "stiffness": 1.0e8, "damping": 1.0e5})
-    return scene_from_dict(data)
-
-
-def _jump_scene():
-    """A 300 kg carriage under a 3000 kg barrel fired at 5 m/s into a stiff damper: the carriage pivots on its
-    spade, the wheels jump 0.1 m off the ground, the spade leaves it too, and both land again.  The spade digs in
-    where it lands (``anchor = "touchdown"``) and holds by its spring alone: a horizontal damper switching on at the
-    touch-down of a spade sliding at 0.3 m/s chatters at the ``reference`` tolerances (the step collapses at
-    0.3915 s; DESIGN.md), and anchored at its old x the spring snaps at 1.9 MN on landing."""
-    return carriage_scene({"carriage.mass": 300.0, "carriage.inertia": 200.0, "barrel.mass": 3000.0,
-                           "barrel.initial_velocity": 5.0, "carriage.support.0.anchor": "touchdown",
-                           "carriage.support.0.horizontal_damping": 0.0},
-                          recoil_damper={"recoil": 6.0e4, "counter_recoil": 6.0e4})
-
-
-def _slipping_scene():
-    """The spade holds by Coulomb friction (mu = 0.05) instead of an anchor: it slides."""
-    data = scene_to_dict(carriage_scene())
-    spade = data["carriage"]["support"][0]
-    del spade["horizontal_stiffness"], spade["horizontal_damping"]
-    spade["friction_coefficient"] = 0.05
-    return scene_from_dict(data)
-
-
-CASES = {"grazing": (_grazing_scene, 1.0), "jump": (_jump_scene, 2.0), "slipping": (_slipping_scene, 1.0)}
+CASES = {"grazing": (grazing_scene, 1.0), "jump": (jump_scene, 2.0), "slipping": (slipping_scene, 1.0)}
 
 
 @pytest.fixture(scope="module")

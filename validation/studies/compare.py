@@ -26,7 +26,46 @@ from mbs_models.scene import Scene
 from ..reference import solve_reference
 from ..reference import ReferenceResult
 
-#: Relative tolerances of the metrics at the ``standard`` preset (validation issue).
+#: The carriage's tolerances per preset (scenes with [carriage]; ``stability_margin`` and ``lift_off_time`` compare
+#: absolutely, 1 and s, below 1).  Measured on the shipped ``towed_howitzer`` and ``towed_howitzer_45`` (3 s), the
+#: test scenes of ``tests/carriage_scenes.py`` and ``tests/planar_scenes.py`` and the hard cases grazing, jump and
+#: slipping of ``tests/engine/test_planar_hard_cases.py`` (1-2 s), the shipped ones also over 10 s (``recoil
+#: validate``'s default): the largest error over those scenes -> the tolerance, about 3x above it (a sampled
+#: extreme's error varies with where the steps fall).  The presets' claims (``mbs_models/engine/accuracy.py``:
+#: 1e-4 / 1e-7 / 1e-9 on a metric) hold for quantities the engine refines; the carriage's extremes (``max_carriage_pitch``, ``max_lift``,
+#: ``max_carriage_displacement``, the supports' least and largest load, hence ``stability_margin``) and
+#: ``lift_off_time`` are taken at the engine's output samples, not refined (DESIGN.md), so their error is the
+#: sampling's, larger than the claim at ``standard`` and ``reference``:
+#:
+#: =========================  ==========================  ==========================  ==========================
+#: quantity                   draft: measured -> tol      standard                    reference
+#: =========================  ==========================  ==========================  ==========================
+#: max_carriage_pitch         7.4e-5 -> 3e-4              3.3e-5 -> 1e-4              2.2e-6 -> 1e-5
+#: max_lift                   1.1e-3 -> 3e-3              3.0e-4 -> 1e-3              5.7e-6 -> 3e-5
+#: lift_off_time (s)          3.4e-4 -> 1e-3              3.8e-5 -> 2e-4              4.3e-6 -> 2e-5
+#: max_carriage_displacement  1.8e-3 -> 5e-3              8.0e-5 -> 3e-4              2.0e-5 -> 1e-4
+#: stability_margin           3.9e-4 -> 2e-3              5.9e-5 -> 2e-4              8.7e-6 -> 3e-5
+#: support_normal_force       8.5e-4 -> 3e-3              5.9e-5 -> 2e-4              8.7e-6 -> 3e-5
+#: carriage_history           4.5e-4 -> 1e-3              4.5e-4 -> 1e-3              4.5e-4 -> 1e-3
+#: =========================  ==========================  ==========================  ==========================
+#:
+#: ``carriage_history`` (and the 1-D ``position_history``, 7.4e-5, and ``max_barrel_displacement``, 1.5e-5, on
+#: ``towed_howitzer``) do not shrink with the preset on the shipped scenes: their floor is the cradle's Coulomb
+#: friction, regularised in the engine and exact in the reference (DESIGN.md, "Coulomb friction": the barrel creeps
+#: at ``v_reg`` while stuck; without the cradle friction the same scene agrees to 6e-10).  On the scenes without
+#: cradle friction the histories agree to 1.3e-5 / 1.7e-7 / 1e-9 at draft / standard / reference.
+CARRIAGE_TOLERANCES = {
+    "draft": {"max_carriage_pitch": 3e-4, "max_lift": 3e-3, "lift_off_time": 1e-3, "max_carriage_displacement": 5e-3,
+              "stability_margin": 2e-3, "support_normal_force": 3e-3, "carriage_history": 1e-3},
+    "standard": {"max_carriage_pitch": 1e-4, "max_lift": 1e-3, "lift_off_time": 2e-4,
+                 "max_carriage_displacement": 3e-4, "stability_margin": 2e-4, "support_normal_force": 2e-4,
+                 "carriage_history": 1e-3},
+    "reference": {"max_carriage_pitch": 1e-5, "max_lift": 3e-5, "lift_off_time": 2e-5,
+                  "max_carriage_displacement": 1e-4, "stability_margin": 3e-5, "support_normal_force": 3e-5,
+                  "carriage_history": 1e-3},
+}
+#: Relative tolerances of the metrics at the ``standard`` preset (validation issue); the carriage's are
+#: :data:`CARRIAGE_TOLERANCES` ``["standard"]``.
 DEFAULT_TOLERANCES = {
     "max_barrel_displacement": 1e-4,
     "time_of_max_barrel_displacement": 1e-3,
@@ -36,17 +75,19 @@ DEFAULT_TOLERANCES = {
     "time_of_max_absorber_velocity": 1e-2,
     # max error of a time history on a common grid, relative to the history's largest magnitude
     "position_history": 1e-3,
-    # the carriage (scenes with [carriage]); stability_margin and lift_off_time near 0 compare absolutely
-    "max_carriage_pitch": 1e-3,
-    "max_lift": 1e-2,
-    "lift_off_time": 1e-3,
-    "max_carriage_displacement": 1e-3,
-    "stability_margin": 1e-3,
-    "support_normal_force": 1e-3,
-    # max error of the carriage's pitch / CG position history at the engine's steps, relative to its largest
-    # change from t = 0
-    "carriage_history": 1e-3,
+    # the carriage (scenes with [carriage]); the support forces relative to the support's static load (the largest
+    # one relative to the larger of it and the reference's largest); the carriage's pitch / CG position history
+    # at the engine's steps relative to its largest change from t = 0
+    **CARRIAGE_TOLERANCES["standard"],
 }
+
+
+def tolerances_for(accuracy: str) -> dict[str, float]:
+    """The tolerances that judge an engine result at ``accuracy``: :data:`DEFAULT_TOLERANCES` with the carriage's of
+    that preset (:data:`CARRIAGE_TOLERANCES`; the ``standard`` ones for settings that are not a preset)."""
+    return {**DEFAULT_TOLERANCES, **CARRIAGE_TOLERANCES.get(accuracy, {})}
+
+
 #: The carriage's scalar metrics compared on a scene with [carriage] (keys of both ``metrics()``).
 CARRIAGE_METRICS = ("max_carriage_pitch", "max_lift", "lift_off_time", "max_carriage_displacement",
                     "stability_margin")
@@ -193,7 +234,8 @@ def history_change_check(name: str, time, ours, reference_history, tolerance: fl
 def carriage_checks(engine, reference, tolerances: dict[str, float]) -> list[QuantityCheck]:
     """The carriage's quantities (module docstring): :data:`CARRIAGE_METRICS`, per support
     ``support.NAME.static_normal_force`` / ``min_normal_force`` / ``max_normal_force`` (tolerance
-    ``support_normal_force``, relative to the support's static load), ``carriage_pitch_history`` and
+    ``support_normal_force``, relative to the support's static load, the largest relative to the larger of its
+    static and largest load; a support carrying nothing at rest: relative to its largest load), ``carriage_pitch_history`` and
     ``carriage_position_history`` (``carriage_history``).  An engine without them fails these checks."""
     ours = engine.metrics() if callable(getattr(engine, "metrics", None)) else {}
     theirs = reference.metrics()
@@ -207,9 +249,12 @@ def carriage_checks(engine, reference, tolerances: dict[str, float]) -> list[Qua
     engine_supports = {s["name"]: s for s in (getattr(engine, "supports", None) or [])}
     for support in reference.supports():
         mine = engine_supports.get(support["name"], {})
-        scale = abs(support["static_normal_force"])
+        static, largest = abs(support["static_normal_force"]), abs(support["max_normal_force"])
         for key in ("static_normal_force", "min_normal_force", "max_normal_force"):
             a, b = mine.get(key), support[key]
+            # relative to the static load (a support carrying nothing at rest: to its largest load, 1 N if it never
+            # touches); the largest load like a peak force, relative to the larger of the two
+            scale = max(static, largest, 1.0) if key == "max_normal_force" or static == 0.0 else static
             error = None if a is None else abs(a - b) / scale
             checks.append(QuantityCheck(f"support.{support['name']}.{key}", a, b, error,
                                         tolerances["support_normal_force"]))
@@ -226,13 +271,14 @@ def carriage_checks(engine, reference, tolerances: dict[str, float]) -> list[Qua
 
 def compare_results(engine: Result, reference: ReferenceResult, tolerances: dict[str, float] | None = None,
                     accuracy: str = "standard") -> Comparison:
-    """Judge an engine result against a reference result of the same scene.
+    """Judge an engine result against a reference result of the same scene, at the tolerances of ``accuracy``
+    (:func:`tolerances_for`) updated by ``tolerances``.
 
     Quantities: the metrics of :data:`DEFAULT_TOLERANCES` (over all absorbers), every contact's peak force
     when the scene has more than one contact, every body's position history and, on a carriage, the carriage's
     quantities (:func:`carriage_checks`).
     """
-    tolerances = {**DEFAULT_TOLERANCES, **(tolerances or {})}
+    tolerances = {**tolerances_for(accuracy), **(tolerances or {})}
     checks = []
     for name in ("max_barrel_displacement", "time_of_max_barrel_displacement", "peak_support_force",
                  "peak_contact_force", "max_absorber_velocity", "time_of_max_absorber_velocity"):
@@ -257,7 +303,7 @@ def compare_results(engine: Result, reference: ReferenceResult, tolerances: dict
 
 def compare(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSettings = "standard",
             tolerances: dict[str, float] | None = None, impact_threshold: float = 1000.0) -> Comparison:
-    """Run the engine and the reference on ``scene`` and compare them (see :data:`DEFAULT_TOLERANCES`)."""
+    """Run the engine and the reference on ``scene`` and compare them (see :func:`tolerances_for`)."""
     engine = simulate(scene, end_time, accuracy, impact_threshold=impact_threshold)
     reference = solve_reference(scene, end_time, impact_threshold=impact_threshold)
     label = accuracy if isinstance(accuracy, str) else accuracy.label()

@@ -141,3 +141,63 @@ def test_a_carriage_comparison_fails_on_a_wrong_or_missing_quantity(carriage_ref
     from validation.studies.compare import compare_results
     comparison = compare_results(_PlanarEngine(carriage_reference, **change), carriage_reference)
     assert not comparison.passed and failing in comparison.failures
+
+
+# ------------------------------------------------------------------ engine = reference on the carriage scenes
+#: The shipped carriage scenes over the time `recoil paper` shows them (the shot, the counter-recoil, the landing).
+SHIPPED_CARRIAGE = {"towed_howitzer": 3.0, "towed_howitzer_45": 3.0}
+
+
+@pytest.fixture(scope="module")
+def shipped_carriage_references():
+    """The reference of each shipped carriage scene, solved once (~1-2 s each) for the three presets."""
+    return {}
+
+
+@pytest.mark.parametrize("preset", ["draft", "standard", "reference"])
+@pytest.mark.parametrize("name", list(SHIPPED_CARRIAGE))
+def test_engine_agrees_with_reference_on_the_shipped_carriage_scenes(shipped_carriage_references, name, preset):
+    """Every quantity within the preset's tolerances (CARRIAGE_TOLERANCES; the 1-D ones at DEFAULT_TOLERANCES), the
+    same impacts, and the carriage's quantities compared at all: the supports, the histories, the metrics."""
+    from validation.studies.compare import compare_results
+    scene, end = load_scene(scene_path(name)), SHIPPED_CARRIAGE[name]
+    if name not in shipped_carriage_references:
+        shipped_carriage_references[name] = solve_reference(scene, end)
+    comparison = compare_results(simulate(scene, end, preset), shipped_carriage_references[name], accuracy=preset)
+    assert comparison.passed, comparison.table()
+    names = {c.name for c in comparison.checks if c.relative_error is not None}
+    assert {"stability_margin", "support.spade.min_normal_force", "support.wheels.max_normal_force",
+            "carriage_pitch_history", "carriage_position_history"} <= names
+
+
+def _hard_case(name):
+    from carriage_scenes import grazing_scene, jump_scene, slipping_scene
+    return {"grazing": (grazing_scene, 1.0), "jump": (jump_scene, 2.0), "slipping": (slipping_scene, 1.0)}[name]
+
+
+@pytest.mark.parametrize("name", ["grazing", "slipping",
+                                  pytest.param("jump", marks=pytest.mark.slow)])  # the jump's reference: ~13 s
+def test_engine_agrees_with_reference_on_the_planar_hard_cases(name):
+    """tests/engine/test_planar_hard_cases.py's scenes at ``standard``: a skid carrying nothing at rest that the
+    pitching touches, a jump whose spade digs in where it lands (anchor = touchdown), a spade slipping by Coulomb
+    friction."""
+    from validation.studies.compare import compare_results
+    make, end = _hard_case(name)
+    scene = make()
+    comparison = compare_results(simulate(scene, end, "standard"), solve_reference(scene, end), accuracy="standard")
+    assert comparison.passed, comparison.table()
+    if name == "grazing":  # the skid: no static load, touched, and not part of the margin
+        skid = comparison.check("support.skid.max_normal_force")
+        assert skid.reference > 10.0 and comparison.reference.supports()[2]["static_normal_force"] == 0.0
+        assert comparison.reference.stability_margin > 0.5
+    if name == "jump":    # it lands again: both see the lift and the landing loads
+        assert comparison.check("max_lift").reference > 0.05
+        assert comparison.check("support.spade.max_normal_force").reference > 100 * 3573.0
+
+
+def test_the_carriage_tolerances_tighten_with_the_preset():
+    from validation.studies.compare import CARRIAGE_TOLERANCES, tolerances_for
+    draft, standard, reference = (tolerances_for(p) for p in ("draft", "standard", "reference"))
+    for key in CARRIAGE_TOLERANCES["standard"]:
+        assert draft[key] >= standard[key] >= reference[key] > 0.0, key
+    assert tolerances_for("DOPRI5 rtol=1e-10") == DEFAULT_TOLERANCES == {**DEFAULT_TOLERANCES, **standard}

@@ -21,9 +21,9 @@ as it stands.  Equations of motion (:mod:`.kinematics`)::
   relative coordinate's acceleration at 0: ``d'' = -G^T q'' = 0`` with ``G = e_a - e_b`` (the axis
   coordinates of its ends; the ground has none), its force F the multiplier:
   ``F = -(G^T M^-1 G)^-1 G^T M^-1 Q`` (Q: every other generalised force minus c);
-* a spade sliding on its clipping surface (:mod:`.supports`) holds the surface's rate ``A + B p''`` at 0 with
-  the share alpha of its holding force ``D`` (generalised): all multipliers together solve
-  ``q'' = M^-1 (Q + D lam)``, ``R q'' = b`` (rows ``R = G^T``, ``b = 0`` for the connectors).
+* a spade sliding on the ground (:mod:`.supports`: p = 0, N = 0) holds its point's ``p'' = 0`` with the share alpha
+  of its force ``D`` (generalised): all multipliers together solve ``q'' = M^-1 (Q + D lam)``, ``R q'' = b`` (rows
+  ``R = G^T``, ``b = 0`` for the connectors).
 
 Dissipated powers: the axis connectors' as in 1-D (a constraint's ``(F - F_c(d)) d'``), the supports'
 (:meth:`.supports.Support.dissipated_power`); the work rate of a load is ``Q_load . q'``.
@@ -65,7 +65,7 @@ class PlanarEvaluation(Evaluation):
     """:class:`~validation.reference.model.Evaluation` (forces, axis accelerations, support force S) plus the
     generalised accelerations ``qdd`` (n rows), each support's ``normal`` and ``tangential`` force (N) and
     dissipated power (W), the axis connectors' ``powers``, the loads' work rates (W) and the share alpha of every
-    sliding spade (``shares``, by support index)."""
+    spade sliding on the ground (``shares``, by support index)."""
 
     qdd: object = None
     normal: list = field(default_factory=list)
@@ -152,8 +152,8 @@ class PlanarModel:
                  free_share: float = 0.0) -> PlanarEvaluation:
         """Everything at a state ``y`` (n,) or a batch (n, N) in ``mode`` (module docstring): floats for a state,
         arrays for a batch.  ``omit``: leave out axis connector ``omit`` (its force, or its constraint);
-        ``free_support``: leave out that support's normal force, and a spade's horizontal force but for the share
-        ``free_share`` of it (1: all of it)."""
+        ``free_support``: leave out that support's forces (normal, and tangential: its friction or spade), but for the
+        share ``free_share`` of a spade's force (1: all of it, with N = 0)."""
         y = np.asarray(y, dtype=float)
         batch = y.ndim == 2
         shape = y.shape[1:]                                       # () for a state, (N,) for a batch
@@ -182,16 +182,16 @@ class PlanarModel:
                 Q += QL
                 work_rates.append(np.sum(QL * qd, axis=0))
         normal, tangential, support_powers = [], [], []
-        sliding = []   # (support index, its holding force's generalised force, row R, right side b)
+        sliding = []   # the spades sliding on the ground: (support index, x_s, u_s)
         for k, s in enumerate(self.supports):
             smode = mode.supports[k]
             if k == free_support:
-                smode = SupportMode(ContactMode(STICK if free_share else OFF, True), smode.slip)
+                smode = SupportMode(ContactMode(STICK if free_share else OFF), smode.slip, smode.anchor)
             x_s, y_s, u_s, w_s = s.motion(g, (X, Yc, phi, dX, dY, dphi))
             Nn = s.normal(smode, -y_s, -w_s)
             if smode.sliding and k != free_support:
-                T = 0.0 * u_s  # its share of the holding force is a multiplier, below
-                sliding.append((k, smode, x_s, u_s, w_s))
+                T = 0.0 * u_s  # its share of the spade's force is a multiplier, below
+                sliding.append((k, smode, x_s, u_s))
             else:
                 T = s.tangential(smode, Nn, x_s, u_s, share=free_share)
             Q[0] += T
@@ -208,7 +208,7 @@ class PlanarModel:
             qdd = np.linalg.solve(M, Q[..., None])[..., 0]
         else:
             # multipliers lam: qdd = M^-1 (Q + D lam) with R qdd = b (the axis constraints: D = G, R = G^T, b = 0;
-            # a sliding spade: D its holding force's generalised force, R qdd = b its surface's rate = 0)
+            # a sliding spade: D its force's generalised force, R qdd = b its point's p'' = 0)
             m = len(held) + len(sliding)
             D = np.zeros(M.shape[:-2] + (g.n, m))
             R = np.zeros(M.shape[:-2] + (m, g.n))
@@ -221,17 +221,16 @@ class PlanarModel:
                     D[..., 3 + c.body_b, col] -= 1.0
                 R[..., col, :] = D[..., :, col]
             cphi, sphi = np.cos(phi), np.sin(phi)
-            for col, (k, smode, x_s, u_s, w_s) in enumerate(sliding, start=len(held)):
+            for col, (k, smode, x_s, u_s) in enumerate(sliding, start=len(held)):
                 support = self.supports[k]
                 rx, ry = support.point
-                full = support.spade_force(x_s, u_s)
+                full = support.spade_force(smode.anchor, x_s, u_s)
                 D[..., 0, col] = full
                 D[..., 2, col] = g.point_force(phi, support.point, full, 0.0)
-                # p'' = -(Y'' + phi'' (c rx - s ry)) + phi'^2 (s rx + c ry); the rate A + B p'' = 0
-                A, B = support.sliding_condition(smode, -w_s)
-                R[..., col, 1] = -B
-                R[..., col, 2] = -B * (cphi * rx - sphi * ry)
-                b[..., col] = -A - B * dphi * dphi * (sphi * rx + cphi * ry)
+                # p'' = -(Y'' + phi'' (c rx - s ry)) + phi'^2 (s rx + c ry) = 0
+                R[..., col, 1] = -1.0
+                R[..., col, 2] = -(cphi * rx - sphi * ry)
+                b[..., col] = -dphi * dphi * (sphi * rx + cphi * ry)
             MD = np.linalg.solve(M, D)                                          # (..., n, m)
             MQ = np.linalg.solve(M, Q[..., None])                               # (..., n, 1)
             lam = np.linalg.solve(R @ MD, b[..., None] - R @ MQ)                # (..., m, 1)
@@ -246,10 +245,10 @@ class PlanarModel:
                           else c.static_force(float(d)))
                 if c.dissipates:
                     powers[self.axis.dissipating.index(c)] = (F - static) * rate
-            for col, (k, smode, x_s, u_s, w_s) in enumerate(sliding, start=len(held)):
+            for col, (k, smode, x_s, u_s) in enumerate(sliding, start=len(held)):
                 share = lam[..., col, 0] if batch else float(lam[col, 0])
                 shares[k] = share
-                tangential[k] = share * self.supports[k].spade_force(x_s, u_s)
+                tangential[k] = share * self.supports[k].spade_force(smode.anchor, x_s, u_s)
         support_powers = [s.dissipated_power(smode, p, rate, Nn, T, u_s, x_s)
                           for s, T, (smode, p, rate, Nn, u_s, x_s) in zip(self.supports, tangential, support_powers)]
         if batch:

@@ -12,7 +12,7 @@ planar state, and it adds (DESIGN.md, "The recoil axis on a carriage", outputs):
   ``max_lift`` (largest height of any support, m; 0 if none leaves the ground), ``lift_off_time`` (the first
   segment end after t = 0 at which a support's normal law stops acting: it leaves the ground, or N reaches 0;
   None if never), ``max_carriage_displacement`` (max |x - x_static| of the CG, m), ``stability_margin``
-  (min over supports and time of ``N_i(t) / N_i(static)``) and :meth:`supports` (per support its static, min and
+  (min over the supports loaded at rest and time of ``N_i(t) / N_i(static)``) and :meth:`supports` (per support its static, min and
   max normal force);
 * the energy balance with gravity's potential of every body and the supports' stored and dissipated energy.
 """
@@ -163,8 +163,10 @@ class PlanarResult(ReferenceResult):
 
     @property
     def stability_margin(self) -> float:
-        """min over supports and time of ``N_i(t) / N_i(static)`` (1: never unloads; 0: a support lets go)."""
-        return min(m["min_normal_force"] / m["static_normal_force"] for m in self._normal_extremes)
+        """min over the supports with a static load ``N_i(static) > 0`` and time of ``N_i(t) / N_i(static)`` (1: never
+        unloads; 0: a support lets go); a support carrying nothing at rest is not part of it."""
+        return min(m["min_normal_force"] / m["static_normal_force"] for m in self._normal_extremes
+                   if m["static_normal_force"] > 0.0)
 
     def supports(self) -> list[dict[str, Any]]:
         """Per support: ``{name, static_normal_force, min_normal_force, max_normal_force}`` (N)."""

@@ -5,9 +5,9 @@ is smooth, every axis connector's and every support's discrete state fixed for a
 (:class:`.model.PlanarMode`), a segment ending at the first switching surface crossed (the axis connectors',
 and the supports': touching or leaving the ground, N reaching 0, the friction's branches), the mode chosen
 again there (:class:`.switching.PlanarRestart`); the loads' breakpoints and the shots are time events (a
-shot: ``x_b' += I / m_b``, :meth:`.model.PlanarModel.apply_impulses`).  Where a spade lets go of the ground
-or takes hold again, its spring's energy ``k_h (x_s - x_s0)^2 / 2`` leaves or enters the balance: it is added
-to (taken from) the support's dissipated energy there.
+shot: ``x_b' += I / m_b``, :meth:`.model.PlanarModel.apply_impulses`).  Where a spade leaves the ground or
+enters it again, its spring's energy ``k_h (x_s - x_s0)^2 / 2`` leaves or enters the balance: it is added
+to (taken from) the support's dissipated energy there (a spade anchored where it touches down enters with none).
 
 The initial state: the axis model's (x_i0, v0 of the barrel, the absorbers at rest), the carriage at rest in the
 static equilibrium (:mod:`.statics`).
@@ -48,17 +48,19 @@ def build_planar_model(scene) -> tuple[PlanarModel, np.ndarray]:
 
 
 def _anchor_jumps(model: PlanarModel, previous, mode, y: np.ndarray) -> np.ndarray:
-    """``y`` with the spades' spring energy moved into (out of) their dissipated energy where one lets go
-    (takes hold) between ``previous`` and ``mode``."""
+    """``y`` with the spades' spring energy moved into (out of) their dissipated energy where one leaves (enters)
+    the ground between ``previous`` and ``mode``."""
     if previous is None:
         return y
     y = y.copy()
     for k, s in enumerate(model.supports):
-        before, after = previous.supports[k].anchored, mode.supports[k].anchored
-        if s.anchored and before != after:
+        before, after = previous.supports[k], mode.supports[k]
+        if s.anchored and before.spring_stored != after.spring_stored:
             x_s = model.support_motion(s)(y)[0]
-            energy = float(s.anchor_energy(x_s))
-            y[model.support_slot + k] += energy if before else -energy
+            if before.spring_stored:
+                y[model.support_slot + k] += float(s.anchor_energy(before.anchor, x_s))
+            else:
+                y[model.support_slot + k] -= float(s.anchor_energy(after.anchor, x_s))
     return y
 
 

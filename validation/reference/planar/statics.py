@@ -11,7 +11,8 @@ the ground and the pitch), in the equilibrium of its vertical force and its mome
 (at rest the friction and a spade anchored at its own static x give no tangential force, so ``Q_X = 0``
 holds for any X; the holding forces on the axis coordinates are internal).  Solved for ``(Y, phi)`` with
 ``scipy.optimize.root`` (Powell's hybrid method) from the rigid-support guess, the residual scaled by the
-weight; a solution with every support in contact and the residual below 1e-10 of the weight is required.
+weight; a solution with the residual below 1e-10 of the weight is required.  A support may carry nothing at rest
+(a skid placed at the ground, or above it, in the equilibrium of the others): it touches only when the gun moves.
 """
 
 from __future__ import annotations
@@ -63,9 +64,6 @@ def static_equilibrium(geometry, supports, xs) -> dict:
                                   f"residual {value})")
     Y, phi = float(solution.x[0]), float(solution.x[1])
     normals = forces(solution.x)
-    if not all(N > 0.0 for N in normals):
-        loose = [s.name for s, N in zip(supports, normals) if not N > 0.0]
-        raise ReferenceModelError(f"carriage: supports {loose} carry no load in the static equilibrium")
     x_points = [float(geometry.place(0.0, Y, phi, s.point)[0]) for s in supports]
     if not all(math.isfinite(v) for v in [Y, phi] + normals):
         raise ReferenceModelError("carriage: the static equilibrium is not finite")

@@ -12,7 +12,7 @@ answering what the connectors ask while they classify themselves:
 
 The supports are classified last (:meth:`.supports.Support.classify`) from their penetration, its rate and
 its free acceleration (their own forces left out; for a spade also with its whole horizontal force and N = 0:
-whether it slides on its clipping surface), the point's horizontal velocity and acceleration and the hints
+whether it slides on the ground), the point's x, horizontal velocity and acceleration and the hints
 ``support.NAME.<event>`` of the event that stopped the previous segment; their events are added to the
 connectors' (a sliding spade's share alpha reaching 0 or 1).
 """
@@ -79,7 +79,7 @@ class PlanarRestart(Restart):
     # ------------------------------------------------------------------ the supports
     def _classify_support(self, k: int, support):
         motion = self.planar.support_motion(support)
-        _, height, u, rise = motion(self.y)
+        x, height, u, rise = motion(self.y)
         dy = self.planar.rhs(self._planar_mode(self.states))(self.t, self.y)
         du = self._rate(lambda y: motion(y)[2], dy)
         free = -self._rate(lambda y: motion(y)[3], self._derivative(free_support=k))
@@ -88,11 +88,12 @@ class PlanarRestart(Restart):
         prefix = support_prefix(support)
         hints = {name[len(prefix):]: v for name, v in self._hints.items() if name.startswith(prefix)}
         previous = None if self.previous is None else self.previous.supports[k]
-        return support.classify(-float(height), -float(rise), free, float(u), du, hints, previous, free_holding)
+        return support.classify(-float(height), -float(rise), free, float(u), du, hints, previous, float(x),
+                                free_holding)
 
     def _derivative(self, free_support=None, free_share=0.0):
-        """dy/dt at the restart with the current states (``free_support``: that support's normal force left out, a
-        spade's horizontal force but for ``free_share`` of it)."""
+        """dy/dt at the restart with the current states (``free_support``: that support's forces left out, a
+        spade's but for ``free_share`` of it)."""
         ev = self.planar.evaluate(self._planar_mode(self.states), self.y, t=self.t, free_support=free_support,
                                   free_share=free_share)
         planar, slot = self.planar, self.planar.carriage_slot
@@ -117,8 +118,7 @@ class PlanarRestart(Restart):
         funcs, names = super().events()
         for k, s in enumerate(self.planar.supports):
             motion = self.planar.support_motion(s)
-            share = self._share_function(k)
-            for event, g, positive in s.events(self.mode.supports[k], motion, share):
+            for event, g, positive in s.events(self.mode.supports[k], motion, self._share_function(k)):
                 value = float(g(self.t, self.y))
                 rate = self._rate(lambda y: g(self.t, y), self.dy)
                 noise = 1e-15 * max(1.0, abs(value))
