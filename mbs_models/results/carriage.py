@@ -8,7 +8,7 @@ applied, evaluated at the samples' states):
 * per support: ``normal_force`` N (N, >= 0), ``tangential_force`` T (N, + = forward, on the carriage) and
   ``height`` ``y = Y + x_s sin(phi) + y_s cos(phi)`` (m; < 0: pressed into the ground);
 * the metrics of DESIGN.md: ``max_carriage_pitch = max |phi - phi_static|`` (rad), ``max_lift = max(0, max y)``
-  (m), ``lift_off_time`` (s, the first time after t = 0 that a support's N reaches 0, None if never),
+  (m), ``lift_off_time`` (s, the first time after t = 0 that a support carrying load at rest has N = 0, None if never),
   ``max_carriage_displacement = max |x_cg - x_cg_static|`` (m) and ``stability_margin = min N_i(t) / N_i(static)``;
 * planar energies: kinetic ``T = sum_k (m_k |v_k|^2 + I_k phi'^2) / 2`` with each CG's absolute velocity, gravity's
   potential ``sum_k m_k g (y_k - y_k(0))``, each support's stored (:func:`~mbs_models.elements.carriage.support_stored_energy`)
@@ -171,6 +171,8 @@ def carriage_output(mechanism, s: Samples, interp: Interpolant, energies=None) -
     t = s.time
     lift_off = None
     for output in supports.values():
+        if not output.static_normal_force > 0.0:  # carried nothing at rest: it cannot leave the ground
+            continue
         off = np.flatnonzero((output.normal_force <= 0.0) & (t > 0.0))
         if len(off):
             lift_off = float(t[off[0]]) if lift_off is None else min(lift_off, float(t[off[0]]))

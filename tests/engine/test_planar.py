@@ -239,3 +239,16 @@ def test_restitution_law_supports_capture_each_touch_down():
     wheels = symbolic.carriage.supports["wheels"]
     assert wheels.max_normal_force > 2 * wheels.static_normal_force  # the landing
     assert np.max(np.abs(symbolic.energy_error())) < 1e-6 * float(symbolic.kinetic_energy_history[0])
+
+
+def test_a_support_that_carries_nothing_at_rest_does_not_lift_off():
+    """A third support held 0.1 m above the ground: it carries nothing, so it neither lifts off at t = 0 nor counts
+    in the stability margin (the reference: the same, tests/validation)."""
+    from mbs_models.scene.io import scene_to_dict
+
+    data = scene_to_dict(carriage_scene({"barrel.initial_velocity": 0.5}))
+    data["carriage"]["support"].append({"name": "skid", "position": [1.4, 0.1], "law": "hertz", "stiffness": 1e8,
+                                        "exponent": 1.5})
+    result = m.simulate(scene_from_dict(data), end_time=0.3)
+    assert result.carriage.supports["skid"].static_normal_force == 0.0
+    assert result.lift_off_time is None and 0.0 < result.stability_margin < 1.0

@@ -10,8 +10,8 @@ planar state, and it adds (DESIGN.md, "The recoil axis on a carriage", outputs):
   the point; < 0 pressed into the ground);
 * metrics, refined on the dense output like every peak: ``max_carriage_pitch`` (max |phi - phi_static|, rad),
   ``max_lift`` (largest height of any support, m; 0 if none leaves the ground), ``lift_off_time`` (the first
-  segment end after t = 0 at which a support's normal law stops acting: it leaves the ground, or N reaches 0;
-  None if never), ``max_carriage_displacement`` (max |x - x_static| of the CG, m), ``stability_margin``
+  segment end after t = 0 at which the normal law of a support loaded at rest stops acting: it leaves the ground,
+  or N reaches 0; None if never), ``max_carriage_displacement`` (max |x - x_static| of the CG, m), ``stability_margin``
   (min over the supports loaded at rest and time of ``N_i(t) / N_i(static)``) and :meth:`supports` (per support its static, min and
   max normal force);
 * the energy balance with gravity's potential of every body and the supports' stored and dissipated energy.
@@ -152,11 +152,14 @@ class PlanarResult(ReferenceResult):
 
     @property
     def lift_off_time(self) -> float | None:
-        """First time (s) after t = 0 at which a support's normal force reaches 0 (its law stops acting); None."""
+        """First time (s) after t = 0 at which a support loaded at rest (``N_i(static) > 0``, as the stability
+        margin counts them) has its normal force reach 0 (its law stops acting); None if never."""
+        loaded = [m["static_normal_force"] > 0.0 for m in self._normal_extremes]
         before = None
         for seg in self.segments:
             holding = [s.holding for s in seg.mode.supports]
-            if before is not None and seg.t0 > 0.0 and any(b and not h for b, h in zip(before, holding)):
+            if before is not None and seg.t0 > 0.0 and any(
+                    b and not h and k for b, h, k in zip(before, holding, loaded)):
                 return float(seg.t0)
             before = holding
         return None
