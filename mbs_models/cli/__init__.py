@@ -202,6 +202,8 @@ def _design_stable(scene, args) -> int:
                  if band.counter_recoil_orifice_area is not None else ""))
         for note in band.notes:
             print(f"    {note}")
+    for elevation, reason in design.refused.items():
+        print(f"  {elevation:5g} deg: left out, the scene is invalid there ({reason})")
     for check in design.checks:
         verdict = "stays down" if check.lift_off_time is None else f"LIFTS at {check.lift_off_time:.3g} s"
         print(f"  {check.elevation:5g} deg: recoil {check.recoil * 1e3:6.1f} mm, peak resistance "

@@ -78,11 +78,14 @@ class ElevationCheck:
 
 @dataclass
 class StableDesign:
-    """The designed scene (with its bands), the bands, the check at every elevation; ``stable``: no support lifts."""
+    """The designed scene (with its bands), the bands, the check at every elevation; ``stable``: no support lifts.
+    ``refused``: elevations at which the scene itself is invalid (its recuperator cannot hold the barrel in battery
+    there, ...), with the reason; they are left out of the design."""
 
     scene: Scene
     bands: list[BandDesign]
     checks: list[ElevationCheck]
+    refused: dict = field(default_factory=dict)
 
     @property
     def stable(self) -> bool:
@@ -90,7 +93,7 @@ class StableDesign:
 
     def to_dict(self) -> dict:
         return {"stable": self.stable, "bands": [b.to_dict() for b in self.bands],
-                "checks": [c.to_dict() for c in self.checks]}
+                "checks": [c.to_dict() for c in self.checks], "refused": self.refused}
 
 
 def _at(scene: Scene, elevation: float) -> Scene:
@@ -127,9 +130,20 @@ def design_stable_brake(scene: Scene, elevations: Sequence[float], bands: Sequen
     if not max_recoil > 0.0:
         raise SceneError("--max-recoil", f"must be a length > 0 m, got {max_recoil:g}")
     elevations = sorted(float(e) for e in elevations)
-    edges = sorted(float(b) for b in bands) + [elevations[-1]]
-    if any(not -90.0 <= e <= 90.0 for e in [*elevations, *edges]):
+    if not elevations:
+        raise SceneError("--elevations", "needs at least one elevation")
+    if any(not -90.0 <= e <= 90.0 for e in [*elevations, *bands]):
         raise SceneError("--elevations", "every elevation and band edge must be in [-90, 90] degrees")
+    refused = {}
+    for elevation in elevations:  # the scene must hold at each elevation (a recuperator's preload, ...)
+        try:
+            _at(scene, elevation)
+        except SceneError as exc:
+            refused[elevation] = f"{exc.key}: {exc.message}"
+    elevations = [e for e in elevations if e not in refused]
+    if not elevations:
+        raise SceneError("--elevations", f"the scene is invalid at every elevation asked: {next(iter(refused.values()))}")
+    edges = sorted(float(b) for b in bands if float(b) < elevations[-1]) + [elevations[-1]]
     designed_bands: list[BandDesign] = []
     lower = -math.inf
     for up_to in edges:
@@ -143,8 +157,9 @@ def design_stable_brake(scene: Scene, elevations: Sequence[float], bands: Sequen
             shortest, length = None, max_recoil
             notes.append(f"no recoil length keeps the gun down at {inside[needs.index(None)]:g} deg by the closed "
                          f"form: designed for the longest allowed, {max_recoil:g} m")
-        else:
-            shortest = max(needs)
+        else:  # the most demanding elevation of the band; inf (any length is stable) asks nothing
+            finite = [n for n in needs if math.isfinite(n)]
+            shortest = max(finite) if finite else math.inf
             length = max_recoil if math.isinf(shortest) else shortest
             if length > max_recoil:
                 notes.append(f"the shortest stable recoil {shortest:.4g} m exceeds the maximum {max_recoil:g} m: "
@@ -173,7 +188,7 @@ def design_stable_brake(scene: Scene, elevations: Sequence[float], bands: Sequen
     for elevation in elevations:
         progress(f"check at {elevation:g} deg")
         checks.append(_check(final, elevation, end_time, accuracy))
-    return StableDesign(final, designed_bands, checks)
+    return StableDesign(final, designed_bands, checks, refused)
 
 
 def _longest_recoil(scene: Scene, accuracy: str, end_time: float) -> float:

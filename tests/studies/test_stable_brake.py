@@ -59,3 +59,12 @@ def test_the_command_writes_the_designed_scene(tmp_path, capsys):
     assert load_scene(out / "designed.toml").recoil_brake.band
     assert json.loads((out / "stable_design.json").read_text())["stable"] is True
     assert main(["design-brake", "model_ii", "--stable", "--out", str(tmp_path / "x")]) == 2
+
+
+def test_an_elevation_where_the_scene_is_invalid_is_left_out_and_said():
+    """The shipped gun's recuperator (48 kN) cannot hold the barrel in battery at 60 degrees (it needs 48.9 kN):
+    that elevation is left out of the design with the scene's own reason; the rest is designed."""
+    scene = load_scene(scene_path("towed_howitzer"))
+    result = design_stable_brake(scene, [45.0, 60.0], margin=0.8, max_recoil=0.9, end_time=3.0)
+    assert list(result.refused) == [60.0] and "recuperator.initial_pressure" in result.refused[60.0]
+    assert [c.elevation for c in result.checks] == [45.0] and result.stable
