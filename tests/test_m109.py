@@ -3,13 +3,15 @@ designed brake's resistance and recoil."""
 
 from __future__ import annotations
 
-import sys
+import importlib.util
 from pathlib import Path
 
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts"))
-import m109_check  # noqa: E402
+_SPEC = importlib.util.spec_from_file_location(
+    "m109_check", Path(__file__).resolve().parents[1] / "scripts" / "m109_check.py")
+m109_check = importlib.util.module_from_spec(_SPEC)
+_SPEC.loader.exec_module(m109_check)
 
 
 def test_the_m109_brake_for_21_inches():

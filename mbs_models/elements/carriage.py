@@ -54,7 +54,7 @@ from typing import ClassVar
 import numpy as np
 
 from ..errors import SceneError
-from .contact_laws import LAW_FIELDS, LAW_RULES, LawFields, law_force
+from .contact_laws import LAW_FIELDS, LAW_RULES, LawFields, OnsetCapture, law_force
 from .ops import Ops
 from .table import Rule, Table, check_choice, check_derived, check_number, ieee_power
 
@@ -298,6 +298,17 @@ def support_stored_energy(support: Support, height, x, anchor: float):
     return energy
 
 
+def onset_capture(support: Support, static_load: float) -> OnsetCapture | None:
+    """A restitution law's capture of ``v-`` at each touch-down (the absorbers' contacts' :class:`OnsetCapture`,
+    on the penetration ``p = -y``), started at rest on the ground under ``static_load`` (N); None for the other
+    laws."""
+    if not support.contact_law.restitution:
+        return None
+    capture = OnsetCapture(support.restitution_factor, support.impact_velocity_floor, 0.0)
+    capture.start(support.static_penetration(static_load), 0.0)
+    return capture
+
+
 class AnchorCapture:
     """A ``touchdown`` spade's anchor (m), captured at the step starts of a solve: while the point is off the
     ground (``height >= 0``) the anchor follows its x, so that it stays where the point last touched down (to
@@ -413,6 +424,6 @@ def static_equilibrium(carriage: Carriage, elevation: float, gravity: float, bod
     return StaticState(height=height, pitch=pitch, loads=loads, anchors=anchors)
 
 
-__all__ = ["Carriage", "Support", "AxisBody", "AnchorCapture", "ANCHORS", "StaticState", "axis_point", "elevation_of", "gravity_of", "rotate",
+__all__ = ["Carriage", "Support", "AxisBody", "AnchorCapture", "ANCHORS", "onset_capture", "StaticState", "axis_point", "elevation_of", "gravity_of", "rotate",
            "world_point", "static_equilibrium", "support_normal_force", "support_tangential_force",
            "support_stored_energy", "DEFAULT_SUPPORT_FRICTION_VELOCITY", "LAW_FIELDS"]

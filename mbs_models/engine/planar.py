@@ -38,9 +38,8 @@ from typing import Any
 
 import numpy as np
 
-from ..elements.carriage import (AnchorCapture, AxisBody, StaticState, elevation_of, gravity_of, static_equilibrium,
+from ..elements.carriage import (AnchorCapture, AxisBody, StaticState, elevation_of, onset_capture, gravity_of, static_equilibrium,
                                  support_normal_force, support_tangential_force)
-from ..elements.contact_laws import OnsetCapture
 from ..elements.ops import PYTHON_OPS, Ops, ops_for
 
 #: Tree coordinates before the axis bodies: X, Y, phi.
@@ -167,9 +166,8 @@ def add_carriage(mbs, mechanism, user_functions: str) -> PlanarItems:
         items.anchor_points[support.name] = support.position
         if support.anchored and support.anchor == "touchdown":
             items.anchors[support.name] = AnchorCapture(static.anchors[support.name])
-        if support.contact_law.restitution:  # v- of each touch-down; at rest on the ground at t = 0
-            capture = OnsetCapture(support.restitution_factor, support.impact_velocity_floor, 0.0)
-            capture.start(support.static_penetration(static.loads[support.name]), 0.0)
+        capture = onset_capture(support, static.loads[support.name])  # v- of each touch-down (restitution laws)
+        if capture is not None:
             items.onsets[support.name] = capture
     _set_tree_forces(mbs, items, mechanism, user_functions, n)
     return items
