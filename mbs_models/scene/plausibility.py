@@ -19,7 +19,10 @@ The checks (DESIGN.md "Unit slips" gives each threshold's reason from real guns)
   when the scene gives it: a ratio outside ``[1 / IMPULSE_RATIO, IMPULSE_RATIO]``, key
   ``firing.pulse.forces`` (or ``.file``; forces in kN, kgf or lbf; times in ms);
 * **peak pulse force** (as applied, after any scaling) below :data:`MIN_PEAK_FORCE_PER_WEIGHT` times the
-  barrel's weight ``M g0``: key ``firing.pulse.forces`` (or ``.file``; forces in kN).
+  barrel's weight ``M g0``: key ``firing.pulse.forces`` (or ``.file``; forces in kN);
+* **a carriage**: its mass outside :data:`CARRIAGE_MASS_RATIO` recoiling masses (``carriage.mass``, in tonnes), its
+  points spanning outside :data:`CARRIAGE_SPAN` (``carriage.support``, positions in mm), a support sinking outside
+  :data:`SUPPORT_PENETRATION` under the whole gun's weight (``carriage.support.N.stiffness``, in N/mm or kN/m).
 """
 
 from __future__ import annotations
@@ -104,10 +107,49 @@ def _pulse(scene: Scene) -> list[Implausible]:
     return out
 
 
+#: The plausible carriage mass, in recoiling masses (towed guns 0.3-3; a self-propelled hull up to ~10).
+CARRIAGE_MASS_RATIO = (0.1, 30.0)
+#: m: the plausible span of a carriage's points (supports, CG, trunnion): a gun is metres long.
+CARRIAGE_SPAN = (0.2, 30.0)
+#: m: the plausible static penetration of a support (a tyre's deflection at most; a spade's soil at least).
+SUPPORT_PENETRATION = (1e-9, 0.3)
+
+
+def _carriage(scene: Scene) -> list[Implausible]:
+    """The carriage's mass against the recoiling parts', its points' span, each support's static penetration."""
+    carriage = getattr(scene, "carriage", None)
+    if carriage is None:
+        return []
+    out = []
+    recoiling = scene.barrel.mass + sum(a.mass for a in scene.absorbers)
+    ratio = carriage.mass / recoiling
+    low, high = CARRIAGE_MASS_RATIO
+    if not low <= ratio <= high:
+        out.append(Implausible("carriage.mass", f"carriage.mass = {carriage.mass:g} kg is {ratio:.3g} times the "
+                                                f"recoiling mass of {recoiling:g} kg (plausible: {low:g} to {high:g} "
+                                                f"times); a mass in tonnes?"))
+    points = [s.position for s in carriage.supports] + [carriage.center_of_mass, carriage.trunnion]
+    span = max(max(abs(a[0] - b[0]), abs(a[1] - b[1])) for a in points for b in points)
+    low, high = CARRIAGE_SPAN
+    if not low <= span <= high:
+        out.append(Implausible("carriage.support", f"the carriage's points (supports, center_of_mass, trunnion) span "
+                                                   f"{span:g} m (plausible: {low:g} to {high:g} m); positions in mm?"))
+    weight = STANDARD_GRAVITY * (carriage.mass + recoiling)
+    low, high = SUPPORT_PENETRATION
+    for i, support in enumerate(carriage.supports):
+        sunk = support.static_penetration(weight)
+        if not low <= sunk <= high:
+            out.append(Implausible(f"carriage.support.{i}.stiffness",
+                                   f"carriage.support.{i}.stiffness = {support.stiffness:g} sinks the support by "
+                                   f"{sunk:.3g} m under the whole gun's weight (plausible: {low:g} to {high:g} m); "
+                                   f"a stiffness in N/mm or kN/m?"))
+    return out
+
+
 def implausible_magnitudes(scene: Scene) -> list[Implausible]:
-    """Every implausible magnitude of ``scene`` (module docstring), barrel first, then the pulse; [] for a
-    plausible scene."""
-    return _recoil_velocity(scene) + _pulse(scene) + _tables(scene)
+    """Every implausible magnitude of ``scene`` (module docstring), barrel first, then the pulse and the carriage;
+    [] for a plausible scene."""
+    return _recoil_velocity(scene) + _pulse(scene) + _carriage(scene) + _tables(scene)
 
 
 def _tables(scene: Scene) -> list[Implausible]:
@@ -118,4 +160,5 @@ def _tables(scene: Scene) -> list[Implausible]:
 
 
 __all__ = ["Implausible", "implausible_magnitudes", "MAX_RECOIL_VELOCITY", "MAX_PULSE_DURATION", "IMPULSE_RATIO",
-           "MIN_PEAK_FORCE_PER_WEIGHT", "STANDARD_GRAVITY"]
+           "MIN_PEAK_FORCE_PER_WEIGHT", "STANDARD_GRAVITY", "CARRIAGE_MASS_RATIO", "CARRIAGE_SPAN",
+           "SUPPORT_PENETRATION"]

@@ -133,3 +133,24 @@ def test_the_shipped_scenes_and_the_papers_models_are_plausible():
         for gap in (0.0, 0.04, 0.08, 0.12):
             assert implausible_magnitudes(model_i(mass, gap)) == implausible_magnitudes(model_ii(mass, gap)) == []
     assert implausible_magnitudes(simplified_model()) == []
+
+
+# ------------------------------------------------------------------ the carriage (issue #22)
+@pytest.mark.parametrize("changes, key, words", [
+    ({"carriage.mass": 2.0}, "carriage.mass", "tonnes"),                      # 2 t typed as 2
+    ({"carriage.support.1.position": [2800.0, 0.0]}, "carriage.support", "mm"),  # 2.8 m typed in mm
+    ({"carriage.support.1.stiffness": 2e3}, "carriage.support.1.stiffness", "N/mm"),  # sinks 15 m
+])
+def test_a_carriage_unit_slip_names_its_key(changes, key, words):
+    from carriage_scenes import carriage_scene
+
+    found = implausible_magnitudes(carriage_scene(changes))
+    assert [f.key for f in found] == [key] and words in found[0].text
+
+
+def test_the_shipped_carriage_scenes_are_plausible():
+    from mbs_models import load_scene
+    from mbs_models.scenes import scene_path
+
+    for name in ("towed_howitzer", "towed_howitzer_45"):
+        assert implausible_magnitudes(load_scene(scene_path(name))) == []
