@@ -214,15 +214,24 @@ class Carriage(Table):
         keys = {f"{key}.mass": self.mass, "barrel.mass": scene.barrel.mass, "cradle.gravity": gravity}
         weight = check_derived(keys, "the gun's weight g (m_c + sum m)", gravity * (self.mass + axis), "N",
                                positive=True)
+        check_derived(keys, "the inverse of the gun's weight 1 / (g (m_c + sum m)) (the stability margin divides by "
+                            "the static loads)", 1.0 / weight, "1/N", positive=True)
         low, high = self.MASS_RATIO
         if not low <= self.mass / axis <= high:
             raise SceneError(f"{key}.mass", f"must be within [{low:g}, {high:g}] times the recoiling mass "
                                             f"({axis:g} kg), got {self.mass:g} kg")
-        points = [s.position for s in self.support] + [self.trunnion]
-        arm = max(max(math.dist(p, self.center_of_mass) for p in points), 1e-3)
-        if not low <= self.inertia / (self.mass * arm ** 2) <= high:
+        points = {f"{key}.support.{i}.position": s.position for i, s in enumerate(self.support)}
+        points[f"{key}.trunnion"] = self.trunnion
+        arm = max(max(math.hypot(p[0] - self.center_of_mass[0], p[1] - self.center_of_mass[1])
+                      for p in points.values()), 1e-3)
+        far = max(points, key=lambda k: math.hypot(*points[k]))
+        moment = check_derived({f"{key}.mass": self.mass, f"{key}.center_of_mass": max(map(abs, self.center_of_mass)),
+                                far: max(map(abs, points[far]))},
+                               "the carriage's inertia about its farthest point m_c L^2", self.mass * ieee_power(arm, 2),
+                               "kg m^2", positive=True)
+        if not low <= self.inertia / moment <= high:
             raise SceneError(f"{key}.inertia", f"must be within [{low:g}, {high:g}] times m_c L^2 = "
-                                               f"{self.mass * arm ** 2:g} kg m^2 (L = {arm:g} m, the largest "
+                                               f"{moment:g} kg m^2 (L = {arm:g} m, the largest "
                                                f"distance of a support or the trunnion from the CG), got "
                                                f"{self.inertia:g}")
         for i, s in enumerate(self.support):
