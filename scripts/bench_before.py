@@ -1,0 +1,175 @@
+"""Issue #24's ratios against the code before it, measured in one run (a part of ``scripts/bench_scipy.py``).
+
+The code before issue #24 is :data:`BASELINE_COMMIT` (main's HEAD when the issue's work began), exported with
+``git archive`` into a temporary directory (no worktree is registered in the repository, nothing is left behind
+if the run is interrupted).  Both trees run in their own interpreter with this venv's python and ``PYTHONPATH``
+pointing to the tree; each worker reports ``mbs_models.__file__`` and the run refuses to measure if a worker
+imported the package from elsewhere.  Three measurements, interleaved between the two trees round by round so
+that a shared machine's load drifts into both alike (and in alternating order):
+
+* a complete ``standard`` run of model (ii) (m = 1000 kg, gap 0), 10 s: median wall and CPU time;
+* an early-stopped point of the Figs 4/5 grid (``stop_when_final=("max_barrel_displacement",)``), serial: CPU time
+  (``time.process_time``) per point, the median over rounds of each round's mean over the points;
+* import to the first result in a fresh interpreter (``import mbs_models`` and ``simulate(model_ii(), 0.01)``):
+  the interpreter's own clock from before the import to the result, the process's wall time and its CPU time
+  (user + system, less sensitive to a shared machine's load); medians.
+
+Each ratio is now / before (< 1: faster now).  With both trees at the same code the ratios must come out ~1:
+that is the check that the measurement is fair.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import resource
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from contextlib import contextmanager
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+#: main's HEAD before issue #24's work (speed): the code the issue's ratios are against.
+BASELINE_COMMIT = "0657fb5eda333496f1c3ed034028224136d77de5"
+#: Figs 4/5 points of the sweep-point measurement: (model, absorber mass kg, gap m).
+SWEEP_POINTS = tuple((model, mass, gap) for model in ("i", "ii") for mass in (100.0, 1000.0)
+                     for gap in (0.0, 0.04, 0.08, 0.12))
+QUICK_SWEEP_POINTS = tuple((model, mass, gap) for model in ("i", "ii") for mass, gap in ((100.0, 0.0), (1000.0, 0.08)))
+
+#: A worker: reports where it imported mbs_models from, then answers one JSON request per line.
+_WORKER = r"""
+import json, sys, time, warnings
+warnings.simplefilter("ignore")
+import mbs_models
+from mbs_models import model_i, model_ii, simulate
+print(json.dumps({"file": mbs_models.__file__}), flush=True)
+for line in sys.stdin:
+    request = json.loads(line)
+    if request["what"] == "run":
+        scene = model_ii(1000.0, 0.0)
+        wall, cpu = time.perf_counter(), time.process_time()
+        result = simulate(scene, 10.0, "standard")
+        answer = {"wall": time.perf_counter() - wall, "cpu": time.process_time() - cpu,
+                  "values": [result.max_barrel_displacement, result.steps]}
+    else:
+        scenes = [(model_i if model == "i" else model_ii)(mass, gap) for model, mass, gap in request["points"]]
+        cpu = time.process_time()
+        values = [simulate(s, 10.0, "standard", stop_when_final=("max_barrel_displacement",)).max_barrel_displacement
+                  for s in scenes]
+        answer = {"cpu": (time.process_time() - cpu) / len(scenes), "values": values}
+    print(json.dumps(answer), flush=True)
+"""
+
+_IMPORT = ("import time; start = time.perf_counter(); import mbs_models; from mbs_models import model_ii, simulate; "
+           "simulate(model_ii(), 0.01); print(time.perf_counter() - start, mbs_models.__file__)")
+
+
+@contextmanager
+def baseline_tree(commit: str = BASELINE_COMMIT):
+    """The files of ``commit`` in a temporary directory (``git archive``), or None without git history."""
+    directory = Path(tempfile.mkdtemp(prefix="recoil-before-24-"))
+    try:
+        archive = subprocess.run(["git", "-C", str(ROOT), "archive", commit], capture_output=True)
+        if archive.returncode != 0:
+            yield None
+            return
+        subprocess.run(["tar", "-x", "-C", str(directory)], input=archive.stdout, check=True, capture_output=True)
+        yield directory
+    finally:
+        shutil.rmtree(directory, ignore_errors=True)
+
+
+def _environment(tree: Path) -> dict:
+    return {**os.environ, "PYTHONPATH": str(tree)}
+
+
+def _check_origin(tree: Path, file: str) -> None:
+    if not Path(file).resolve().is_relative_to(tree.resolve()):
+        raise RuntimeError(f"a worker for {tree} imported mbs_models from {file}: the measurement would be wrong")
+
+
+class Worker:
+    """A python process with ``tree`` on its path, answering the requests of :data:`_WORKER`."""
+
+    def __init__(self, tree: Path):
+        self.process = subprocess.Popen([sys.executable, "-c", _WORKER], cwd=str(tree), env=_environment(tree),
+                                        stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+        self.file = json.loads(self.process.stdout.readline())["file"]
+        _check_origin(tree, self.file)
+
+    def ask(self, **request) -> dict:
+        self.process.stdin.write(json.dumps(request) + "\n")
+        self.process.stdin.flush()
+        line = self.process.stdout.readline()
+        if not line:
+            raise RuntimeError(f"the worker importing {self.file} ended (exit code {self.process.wait()})")
+        return json.loads(line)
+
+    def close(self) -> None:
+        self.process.stdin.close()
+        self.process.wait(timeout=60)
+
+
+def import_once(tree: Path) -> tuple[float, float, float]:
+    """(seconds from before ``import mbs_models`` to the first result, in the interpreter; the process's wall
+    seconds; its CPU seconds, user + system) with the code in ``tree``."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    start = time.perf_counter()
+    out = subprocess.run([sys.executable, "-c", _IMPORT], cwd=str(tree), env=_environment(tree), check=True,
+                         capture_output=True, text=True).stdout.split()
+    wall = time.perf_counter() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    _check_origin(tree, out[1])
+    return float(out[0]), wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+
+
+def _alternating(items: dict, round_: int) -> list:
+    """The items in their order in even rounds, reversed in odd ones (neither tree always goes first)."""
+    pairs = list(items.items())
+    return pairs if round_ % 2 == 0 else pairs[::-1]
+
+
+def measure(trees: dict[str, Path], rounds: int = 9, points=SWEEP_POINTS, import_rounds: int = 9,
+            progress=lambda message: None) -> dict:
+    """Median times per tree (``{"run wall", "run cpu", "point cpu", "import", "import process", "import process
+    cpu"}`` in s), the
+    files each imported (``"file"``) and whether the trees gave the same values (``"same values"``)."""
+    samples: dict[str, dict[str, list[float]]] = {name: {} for name in trees}
+    values: dict[str, list] = {name: [] for name in trees}
+    workers = {name: Worker(tree) for name, tree in trees.items()}
+    try:
+        for worker in workers.values():  # warm-up: first calls, caches, symbolic user functions
+            worker.ask(what="run")
+            worker.ask(what="points", points=[list(p) for p in points[:2]])
+        for round_ in range(rounds):
+            progress(f"before/now: run and sweep points, round {round_ + 1} of {rounds}")
+            for name, worker in _alternating(workers, round_):
+                run = worker.ask(what="run")
+                sweep = worker.ask(what="points", points=[list(p) for p in points])
+                samples[name].setdefault("run wall", []).append(run["wall"])
+                samples[name].setdefault("run cpu", []).append(run["cpu"])
+                samples[name].setdefault("point cpu", []).append(sweep["cpu"])
+                if round_ == 0:
+                    values[name] = [run["values"], sweep["values"]]
+    finally:
+        for worker in workers.values():
+            worker.close()
+    for name, tree in trees.items():  # warm-up: the baseline's tree compiles its .pyc files here
+        import_once(tree)
+    for round_ in range(import_rounds):
+        progress(f"before/now: import to the first result, round {round_ + 1} of {import_rounds}")
+        for name, tree in _alternating(trees, round_):
+            inside, process, cpu = import_once(tree)
+            samples[name].setdefault("import", []).append(inside)
+            samples[name].setdefault("import process", []).append(process)
+            samples[name].setdefault("import process cpu", []).append(cpu)
+    out = {name: {key: statistics.median(v) for key, v in s.items()} for name, s in samples.items()}
+    for name in trees:
+        out[name]["file"] = workers[name].file
+    first = next(iter(values.values()))
+    out["same values"] = all(v == first for v in values.values())
+    return out
