@@ -35,6 +35,10 @@ What it measures (not a timed test: the numbers depend on the machine; the ratio
 7. **The whole-paper job**: wall time of a full ``recoil paper`` before issue #11 and now (``--paper``).
 8. **The planar model** (issue #22, :mod:`bench_carriage`): each shipped carriage scene against the same hardware
    without ``[carriage]``, per simulated second, and Exudyn's floor (a bare tree against a bare 1-D mass, per step).
+9. **Issue #24** (:mod:`bench_scipy`, about 1-2 minutes; ``--issue24-quick`` about half a minute): a plain scipy
+   script of model (ii) written from the equations (``scripts/plain_scipy.py``) at equal accuracy on *each*
+   metric separately against ``standard`` and ``draft`` (section 1 matches the worst of the three), and a complete
+   run, an early-stopped sweep point and import to the first result now / before issue #24.
 
 It ends with issue #11's targets, each ratio beside its target.  Absolute times are printed only in
 brackets beside the ratios, for context.
@@ -274,6 +278,9 @@ def main(argv=None) -> int:
     parser.add_argument("--skip-sweeps", action="store_true", help="skip the Figs 4/5 sweep throughput")
     parser.add_argument("--skip-carriage", action="store_true",
                         help="skip the carriage scenes against their 1-D twins (section 8)")
+    parser.add_argument("--skip-issue24", action="store_true",
+                        help="skip issue #24's section (scipy at equal accuracy per metric, now / before #24)")
+    parser.add_argument("--issue24-quick", action="store_true", help="the shorter issue #24 section")
     parser.add_argument("--gap-count", type=int, default=121,
                         help="gaps of the Figs 4/5 sweep per model and mass (default 121: 726 points)")
     parser.add_argument("--sweep-rounds", type=int, default=3,
@@ -454,7 +461,8 @@ def main(argv=None) -> int:
           f"{100 * t_standard_solve / t_standard:.0f} % of a complete run [context: {ms(t_standard)}]")
     print(f"machine load: wall / CPU time of the standard run {load:.2f} "
           f"({'idle enough' if load < 1.15 else 'shared machine: trust the CPU-time ratios'})")
-    print("\n1. standard vs scipy LSODA at equal accuracy (same equations, no events, dense output)")
+    print("\n1. standard vs scipy LSODA at equal accuracy (same equations, no events, dense output; the worst of the "
+          "three metrics: section 9 matches each separately)")
     if lsoda is None:
         print("   LSODA reached the standard preset's accuracy at no tolerance down to 1e-13: no ratio")
     else:
@@ -568,6 +576,11 @@ def main(argv=None) -> int:
         tree, mass = bench_carriage.bare_floor()
         print(f"   Exudyn's floor per fixed DOPRI5 step: a bare tree of the planar links {tree / mass:5.1f}x a bare "
               f"1-D mass [{tree:.1f} / {mass:.1f} us] (scripts/bench_carriage.py: the floor per simulated second)")
+    if not args.skip_issue24:
+        import bench_scipy
+
+        sys.stdout.flush()
+        bench_scipy.run_section(quick=args.issue24_quick, progress=say)
     return 0
 
 
