@@ -11,5 +11,9 @@
   stop once they prove the peak metrics final (:mod:`.final_metrics` re-exports both);
 * :mod:`.reach` -- contacts that can never close (a gap beyond the barrel's free-recoil travel).
 
-This package imports Exudyn.
+This package imports Exudyn, choosing its fast compiled module first (:mod:`.exudyn_build`).
 """
+
+from .exudyn_build import load_exudyn as _load_exudyn
+
+_load_exudyn()  # before any module of the engine imports Exudyn
