@@ -74,12 +74,12 @@ class ElevationPoint:
 
 @dataclass(frozen=True)
 class Geometry:
-    """What the closed form needs of a scene: masses (kg), the weight moment's arm d (m) about the pivot, the
-    pivot and trunnion (m), gravity (m/s^2) and the free-recoil energy (J)."""
+    """What the closed form needs of a scene: masses (kg), the carriage's weight moment ``m_c (x_c - x_P)`` (kg m)
+    about the pivot, the pivot and trunnion (m), gravity (m/s^2) and the free-recoil energy (J)."""
 
     total_mass: float
     recoiling_mass: float
-    moment_arm: float
+    carriage_moment: float
     pivot: tuple[float, float]
     trunnion: tuple[float, float]
     gravity: float
@@ -104,7 +104,7 @@ class Geometry:
         """``m_tot d`` (kg m) in battery at ``theta`` (rad): the carriage's and the recoiling parts' (their CG at
         ``trunnion + b e``)."""
         x, _ = axis_point(scene.carriage, theta, 0.0)
-        return self.moment_arm + self.recoiling_mass * (x - self.pivot[0])
+        return self.carriage_moment + self.recoiling_mass * (x - self.pivot[0])
 
     def arm(self, theta: float) -> float:
         """h(theta) (m): the axis' arm about the pivot (module docstring)."""
