@@ -9,11 +9,29 @@ differences and evaluations of ``law``), never from the closed form under test.
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 
 from mbs_models.elements import Connector
 from mbs_models.elements.ops import NUMPY_OPS, PYTHON_OPS, symbolic_ops
+
+#: The shipped scene files (every element and contact law has one: tests/elements/test_conformance.py checks it).
+SCENE_FILES = sorted((Path(__file__).parents[1] / "mbs_models" / "scenes").glob("*.toml"))
+
+
+def shipped_scenes() -> dict:
+    """Every shipped scene by its file's stem."""
+    from mbs_models import load_scene
+
+    return {path.stem: load_scene(path) for path in SCENE_FILES}
+
+
+def shipped_connectors(scenes: dict) -> dict:
+    """Every connector of ``scenes`` as the engine builds it, keyed ``"scene:connector"``."""
+    from mbs_models.engine.mechanism import Mechanism
+
+    return {f"{key}:{c.name}": c for key, scene in scenes.items() for c in Mechanism(scene).connectors}
 
 #: Boxes |d| <= D (m), |d'| <= V (m/s) sampled for a connector; a contact's D is its penetration bound.
 BOXES = ((1e-3, 0.05), (0.05, 1.0), (0.3, 3.0))

@@ -10,30 +10,16 @@ wrong closed-form potential: the two omissions of issue #21) must fail the same 
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import pytest
 
 import conformance
-from mbs_models import load_scene
 from mbs_models.elements import ELEMENT_TABLES, GROUND, Connector, LinearSpringDamper
 from mbs_models.elements.contact_laws import CONTACT_LAWS
 from mbs_models.engine.energy_bounds import dissipative
-from mbs_models.engine.mechanism import Mechanism
 
-SCENE_FILES = sorted((Path(__file__).parents[2] / "mbs_models" / "scenes").glob("*.toml"))
-SCENES = {path.stem: load_scene(path) for path in SCENE_FILES}
-
-
-def _connectors():
-    out = {}
-    for key, scene in SCENES.items():
-        for connector in Mechanism(scene).connectors:
-            out[f"{key}:{connector.name}"] = connector
-    return out
-
-
-CONNECTORS = _connectors()
+SCENES = conformance.shipped_scenes()
+CONNECTORS = conformance.shipped_connectors(SCENES)
 
 
 def test_the_shipped_scenes_hold_every_element_and_every_contact_law():

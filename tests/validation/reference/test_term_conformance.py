@@ -19,23 +19,19 @@ test.
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 import conformance
 
-from mbs_models import load_scene
 from mbs_models.elements.ops import PYTHON_OPS
-from mbs_models.engine.mechanism import Mechanism
 from validation.reference import terms
 from validation.reference.assembly import build_model
 from validation.reference.model import BARREL, GROUND, Connector, Mode
 from validation.reference.terms.contact_laws import ON, RESTITUTION_LAWS, ContactMode
 
-SCENE_FILES = sorted((Path(__file__).parents[3] / "mbs_models" / "scenes").glob("*.toml"))
-SCENES = {path.stem: load_scene(path) for path in SCENE_FILES}
+SCENES = conformance.shipped_scenes()
 MODELS = {key: build_model(scene) for key, scene in SCENES.items()}
 TERMS = {f"{key}:{c.name}": (key, c) for key, model in MODELS.items() for c in model.connectors}
 
@@ -229,15 +225,7 @@ def test_the_compiled_equations_are_the_law_and_its_dissipated_power(key):
 
 
 # ------------------------------------------------------------------------------------------ engine = reference
-def _engine_connectors():
-    out = {}
-    for key, scene in SCENES.items():
-        for connector in Mechanism(scene).connectors:
-            out[f"{key}:{connector.name}"] = connector
-    return out
-
-
-ENGINE = _engine_connectors()
+ENGINE = conformance.shipped_connectors(SCENES)
 
 
 def test_the_engine_and_the_reference_have_the_same_connectors():
