@@ -47,6 +47,7 @@ engine assembles them (:mod:`mbs_models.engine.planar`), the reference writes it
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import ClassVar
@@ -376,6 +377,13 @@ def world_point(offset_x: float, offset_y: float, pitch: float, point) -> tuple[
 
 
 def static_equilibrium(carriage: Carriage, elevation: float, gravity: float, bodies) -> StaticState:
+    """:func:`_static_equilibrium` of the bodies as a tuple: computed once per gun (the assembly and the
+    post-processing of a run both need it; the tables are frozen, the result is read only)."""
+    return _static_equilibrium(carriage, float(elevation), float(gravity), tuple(bodies))
+
+
+@functools.lru_cache(maxsize=64)
+def _static_equilibrium(carriage: Carriage, elevation: float, gravity: float, bodies) -> StaticState:
     """The static equilibrium of the gun on its supports (DESIGN.md "Initial state"): the axis ``bodies``
     (:class:`AxisBody`) held at their ``position``, the carriage at ``X = 0`` (no horizontal force acts at rest:
     friction and an unstretched spade give none) and at the height ``Y`` and pitch ``phi`` where

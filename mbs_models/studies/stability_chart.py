@@ -199,7 +199,8 @@ def recoil_margins(scene: Scene, result) -> tuple[float, float]:
     simulated = result.carriage.supports[front].normal_force
     closed = front_load(scene, result.support_force, result.positions)
     theta = math.radians(scene.cradle.elevation if scene.cradle is not None else 0.0)
-    holding = Geometry.of(scene).gravity * math.sin(theta) * Geometry.of(scene).recoiling_mass  # R at rest
+    geometry = Geometry.of(scene)
+    holding = geometry.gravity * math.sin(theta) * geometry.recoiling_mass  # R at rest
     static = front_load(scene, np.array([holding]), {name: values[:1] for name, values in result.positions.items()})
     return (float(np.min(simulated[stroke]) / result.carriage.supports[front].static_normal_force),
             float(np.min(closed[stroke]) / static[0]))
