@@ -7,6 +7,8 @@
 
 * stepped over a whole contact with a smaller ``max_step`` (:func:`_settings_after_stepped_over_contacts`,
   at most :data:`MAX_CONTACT_RETRIES` times);
+* only grazed a contact, with a maximum step above :data:`~mbs_models.engine.stability.GRAZING_MAX_STEP`
+  (:func:`_settings_after_grazed_contacts`, once);
 * stalled on Exudyn's error-scale bug with absolute error control (:func:`_absolute_tolerance_settings`, once).
 
 What it collected is a :class:`Solve`; what the run *means* (why it stopped, which metrics are final) is the run
@@ -417,6 +419,18 @@ def _settings_after_stepped_over_contacts(mechanism: Mechanism, samples: Samples
     return replace(settings, max_step=min(settings.max_step, shortest) / 4.0)
 
 
+def _settings_after_grazed_contacts(mechanism: Mechanism, samples: Samples, settings: SolverSettings
+                                    ) -> SolverSettings | None:
+    """Settings for a re-solve with ``max_step`` at most :data:`~mbs_models.engine.stability.GRAZING_MAX_STEP`
+    if an adaptive solve with a larger one only grazed a contact (:func:`~mbs_models.engine.stability.grazed_contacts`);
+    else None."""
+    if not settings.adaptive or settings.max_step <= stability.GRAZING_MAX_STEP:
+        return None
+    if not stability.grazed_contacts(mechanism, samples.positions):
+        return None
+    return replace(settings, max_step=stability.GRAZING_MAX_STEP)
+
+
 class FreshModels:
     """Where :func:`simulate_with` gets its Exudyn systems: a new :func:`~mbs_models.engine.assembly.assemble`
     for every solve, closed after it.  :class:`mbs_models.engine.reuse.Simulator` keeps them instead."""
@@ -494,7 +508,10 @@ def drive(models: FreshModels, scene: Scene, policy: RunPolicy) -> Solve:
         finally:
             models.release(assembly, failed)
         retry = _settings_after_stepped_over_contacts(mechanism, samples, settings, policy.impact_threshold, attempt)
-        attempt += 1
+        if retry is not None:
+            attempt += 1
+        else:
+            retry = _settings_after_grazed_contacts(mechanism, samples, settings)
         if retry is None:
             break
         settings = retry

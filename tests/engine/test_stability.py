@@ -21,7 +21,7 @@ from exudyn.itemInterface import (MarkerNodeCoordinate, NodeGenericODE2, NodePoi
 
 import mbs_models.engine.stability as stability
 from mbs_models import SceneError, SimulationError, SolverSettings, model_i, model_ii, simplified_model, simulate
-from mbs_models.engine.accuracy import FIXED_STEP_SOLVERS, IMPLICIT_SOLVERS
+from mbs_models.engine.accuracy import ACCURACY_PRESETS, FIXED_STEP_SOLVERS, IMPLICIT_SOLVERS
 from mbs_models.engine.mechanism import Mechanism
 from mbs_models.engine.stability import AccuracyWarning
 from validation.reference import solve_reference
@@ -313,6 +313,40 @@ def test_adaptive_solver_re_solves_a_stepped_over_contact():
     assert result.settings.max_step < 1e-3
     assert result.peak_contact_force == pytest.approx(ref.peak_contact_force, rel=1e-2)
     assert result.impacts == [] and ref.impacts == []
+
+
+def test_grazed_contact_is_found_from_its_depth_against_the_positions():
+    """A contact touched 1e-6 m deep by a barrel 0.2 m from home is grazed (ratio 5e-6 < 1e-4); 1e-3 m deep is not;
+    no touch, or one below the round-off of the positions, is not a contact at all."""
+    mechanism = Mechanism(model_ii(1000.0, 0.1))
+    contact = mechanism.contacts[0]
+    assert (contact.a, contact.b) == ("absorber", "barrel")  # d = x_barrel - x_absorber
+
+    def positions(depth):
+        barrel = np.linspace(0.0, 0.2, 5)
+        d = np.array([-1.0, -0.5, -0.1, contact.offset + depth, -0.2])
+        return {"barrel": barrel, "absorber": barrel - d}
+
+    found = stability.grazed_contacts(mechanism, positions(1e-6))
+    assert [name for name, _, _ in found] == [contact.name]
+    assert found[0][1] == pytest.approx(1e-6, rel=1e-6)
+    assert found[0][2] == pytest.approx(1.0)  # the largest |x| of either body: the absorber at 0 - (-1.0) m
+    for depth in (1e-3, -1e-3, 1e-13):
+        assert stability.grazed_contacts(mechanism, positions(depth)) == []
+
+
+GRAZED = model_ii(1000.0, 0.2214770 - 5e-8).with_changes(**{"contact.stiffness": 1e12})  # hard case graze-stiff
+
+
+def test_a_grazed_contact_is_re_solved_with_the_grazing_max_step():
+    """The presets' large max step leaves the barrel's position error at the turning point near the tolerance;
+    the 4e-7 m graze of a 1e12 N/m^1.5 contact turns it into a peak-force error beyond the guarantee: re-solved."""
+    result = simulate(GRAZED, 1.0, "standard")
+    assert result.settings.max_step == stability.GRAZING_MAX_STEP < ACCURACY_PRESETS["standard"].max_step
+    ref = solve_reference(GRAZED, 1.0, max_step=1e-3)
+    assert result.peak_contact_force == pytest.approx(ref.peak_contact_force, rel=2e-5)  # the standard guarantee
+    # a full impact is no graze: the run keeps the preset's max step
+    assert simulate(model_ii(1000.0, 0.0), 1.0, "standard").settings.max_step == ACCURACY_PRESETS["standard"].max_step
 
 
 # ------------------------------------------------------------------------------------------------
