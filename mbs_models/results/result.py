@@ -166,6 +166,22 @@ class Result:
             object.__setattr__(self, "requested_end_time", self.end_time)
         object.__setattr__(self, "stop_reason", StopReason(self.stop_reason))  # its text (an old value) read back
 
+    def state_at(self, t) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
+        """Every body's position (m) and velocity (m/s) at times ``t`` (s, any shape, within ``[0, end_time]``):
+        ``(positions, velocities)`` by body name, each of ``t``'s shape.
+
+        The cubic Hermite interpolant of the step-end samples (position from velocity, velocity from
+        acceleration; :mod:`mbs_models.results.samples`), the one the metrics are refined on: histories at any
+        sampling interval (``result.state_at(np.arange(0.0, result.end_time, 1e-3))``) without small steps; at a
+        sample time, the sample itself.  Raises ``ValueError`` for a time outside the histories."""
+        from .samples import Interpolant, Samples
+
+        t = np.asarray(t, dtype=float)
+        if t.size and not (np.min(t) >= self.time[0] and np.max(t) <= self.time[-1]):
+            raise ValueError(f"state_at: times must lie in [{self.time[0]:g}, {self.time[-1]:g}] s (the histories), "
+                             f"got [{np.min(t):g}, {np.max(t):g}] s")
+        return Interpolant(Samples(self.time, self.positions, self.velocities, self.accelerations)).state(t)
+
     # ------------------------------------------------------------------ version-1 shortcuts
     @property
     def barrel_position(self) -> np.ndarray:
