@@ -461,6 +461,11 @@ def main(argv=None) -> int:
           f"{100 * t_standard_solve / t_standard:.0f} % of a complete run [context: {ms(t_standard)}]")
     print(f"machine load: wall / CPU time of the standard run {load:.2f} "
           f"({'idle enough' if load < 1.15 else 'shared machine: trust the CPU-time ratios'})")
+    floor_step, solve_step = t["exudyn floor per step"], t_standard_solve / result.steps
+    print(f"per step ({result.steps} steps, max step {standard.max_step * 1e3:g} ms): the standard solve "
+          f"{1e6 * solve_step:.2f} us, the complete run {1e6 * t_standard / result.steps:.2f} us; Exudyn's floor "
+          f"{1e6 * floor_step:.2f} us: solve / floor {solve_step / floor_step:.2f}x (issue #24's target <= 1.3), "
+          f"complete run / floor {t_standard / result.steps / floor_step:.2f}x")
     print("\n1. standard vs scipy LSODA at equal accuracy (same equations, no events, dense output; the worst of the "
           "three metrics: section 9 matches each separately)")
     if lsoda is None:

@@ -170,6 +170,7 @@ def measure(trees: dict[str, Path], rounds: int = 9, points=SWEEP_POINTS, import
     out = {name: {key: statistics.median(v) for key, v in s.items()} for name, s in samples.items()}
     for name in trees:
         out[name]["file"] = workers[name].file
+        out[name]["values"] = values[name]  # [[displacement m, steps] of the run, [displacement m per point]]
     first = next(iter(values.values()))
     out["same values"] = all(v == first for v in values.values())
     return out

@@ -242,6 +242,13 @@ def print_before(out: dict) -> None:
     before, now = out["before"], out["now"]
     print(f"   baseline {out['commit'][:12]} imported from {before['file']}; now from {now['file']}; "
           f"same results: {out['same values']}")
+    if "values" in now and "values" in before:  # a changed integration path (the max step) moves the last digits
+        (x_now, steps_now), points_now = now["values"]
+        (x_before, steps_before), points_before = before["values"]
+        moved = max([abs(x_now - x_before) / abs(x_before)]
+                    + [abs(a - b) / abs(b) for a, b in zip(points_now, points_before) if b])
+        print(f"   the standard run's steps now/before {steps_now} / {steps_before} = {steps_now / steps_before:.3f}; "
+              f"largest relative change of a displacement (the run and every sweep point): {moved:.1e}")
     rows = [("complete standard run, model (ii) 10 s (wall)", "run wall", 1 / 1.6),
             ("complete standard run (CPU)", "run cpu", 1 / 1.6),
             (f"early-stopped sweep point, CPU per point ({out['points']} points)", "point cpu", 1 / 1.5),

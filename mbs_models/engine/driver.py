@@ -9,6 +9,10 @@
   at most :data:`MAX_CONTACT_RETRIES` times);
 * only grazed a contact, with a maximum step above :data:`~mbs_models.engine.stability.GRAZING_MAX_STEP`
   (:func:`_settings_after_grazed_contacts`, once);
+* diverged (NaN or inf in its output) with an adaptive solver, with ``max_step / 4`` (at most
+  :data:`MAX_DIVERGENCE_RETRIES` times): a trial step as long as the maximum step, taken from a slow phase into a
+  stiff one (a damper of a millisecond's time constant), can reach states where a law is not finite, and Exudyn
+  accepts a step whose error estimate is NaN;
 * stalled on Exudyn's error-scale bug with absolute error control (:func:`_absolute_tolerance_settings`, once).
 
 What it collected is a :class:`Solve`; what the run *means* (why it stopped, which metrics are final) is the run
@@ -33,13 +37,15 @@ from .assembly import Assembly, assemble
 from .finality import FinalityTracker
 from .guard import StepBudget, sample_cap
 from .mechanism import Mechanism
-from .readout import collect, read_segment
+from .readout import NonFiniteSolve, collect, read_segment
 from .rest import RestWatch
 from .run_policy import RunPolicy, _check_bounds
 from .time_scales import time_scale_hint
 
 #: Re-solves (with max_step / 4 each) when an adaptive solver stepped over a whole contact.
 MAX_CONTACT_RETRIES = 3
+#: Re-solves (with max_step / 4 each) when an adaptive solve diverged (NaN or inf in its output).
+MAX_DIVERGENCE_RETRIES = 3
 #: The finality tracker (stop_when_final) is shown the state at every this-many-th step: an observed step's
 #: pre-step call (reading the state, the bounds) costs ~10 us inside a solve, a step ~5 us (README, cost
 #: section; scripts/bench_prestep.py).  Changing it changes when early stops happen (not bit-identical).
@@ -382,7 +388,7 @@ def _run_segments(assembly: Assembly, settings: SolverSettings, end_time: float,
             load.start_segment(t0)
         n, simulated_end = _solve(assembly, segment_settings, t1, tracker, t0, run)
         steps += n
-        segments.append(read_segment(assembly, settings, t0, accelerations))
+        segments.append(_ending_at(read_segment(assembly, settings, t0, accelerations), t1))
         if tracker is not None and tracker.done:
             break
         settled = rest.settle(t0, t1, segments[-1]) if rest is not None else None
@@ -390,6 +396,22 @@ def _run_segments(assembly: Assembly, settings: SolverSettings, end_time: float,
             segments[-1], simulated_end = settled, rest.time
             break
     return steps, simulated_end, collect(assembly, simulated_end, settings, segments=segments)
+
+
+#: A segment's last output time within this (relative to max(1 s, its end)) of the segment's end is its end.
+SEGMENT_END_ROUND_OFF = 1e-12
+
+
+def _ending_at(segment: tuple, end: float) -> tuple:
+    """A segment's ``(time, values)`` with its last time set to the segment's ``end`` (s) where it differs by round-off
+    only: Exudyn sums its steps (``span / numberOfSteps`` each, where the maximum step binds), so a segment from 0.5 s
+    to 0.75 s in 7 steps ends at 0.7499999999999999 s -- and the next, starting at 0.75 s with a shot's jump, would
+    not share its time (the jump is a zero-length interval the post-processing recognises)."""
+    time, values = segment
+    if len(time) and time[-1] != end and abs(time[-1] - end) <= SEGMENT_END_ROUND_OFF * max(1.0, abs(end)):
+        time = time.copy()
+        time[-1] = end
+    return time, values
 
 
 def _settings_after_stepped_over_contacts(mechanism: Mechanism, samples: Samples, settings: SolverSettings,
@@ -477,7 +499,7 @@ def drive(models: FreshModels, scene: Scene, policy: RunPolicy) -> Solve:
     :func:`~mbs_models.engine.run_policy._check_bounds`).
     """
     settings, end_time = policy.settings, policy.end_time
-    attempt = 0
+    attempt = diverged = 0
     checked = False
     while True:
         mechanism = Mechanism(scene)  # fresh: contacts carry the onset capture of one solve
@@ -499,6 +521,13 @@ def drive(models: FreshModels, scene: Scene, policy: RunPolicy) -> Solve:
                 solved = _time.perf_counter()
                 samples = collect(assembly, simulated_end, settings, initial_accelerations)
             failed = False
+        except NonFiniteSolve as failure:
+            if not settings.adaptive or diverged >= MAX_DIVERGENCE_RETRIES:
+                again = f" (also with max_step = {settings.max_step:.3g} s)" if diverged else ""
+                raise SimulationError(f"{failure}{again}") from None
+            diverged += 1
+            settings = replace(settings, max_step=settings.max_step / 4.0)
+            continue
         except _StepSizeStalled as stalled:
             retry = _absolute_tolerance_settings(settings) if settings.adaptive else None
             if retry is None:

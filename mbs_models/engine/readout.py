@@ -16,6 +16,11 @@ from .accuracy import SolverSettings
 from .assembly import Assembly
 
 
+
+class NonFiniteSolve(SimulationError):
+    """A solve's sensors hold NaN or inf: the solve diverged (the driver re-solves an adaptive one with a smaller
+    maximum step, :data:`~mbs_models.engine.driver.MAX_DIVERGENCE_RETRIES` times at most)."""
+
 def _stored(assembly: Assembly, name: str) -> np.ndarray:
     return np.asarray(assembly.mbs.GetSensorStoredData(assembly.sensors[name]), dtype=float)
 
@@ -38,7 +43,7 @@ def read_segment(assembly: Assembly, settings: SolverSettings, start_time: float
     for name, data in columns.items():
         if not np.isfinite(data).all():
             first = int(np.flatnonzero(~np.all(np.isfinite(data), axis=1))[0])
-            raise SimulationError(f"Exudyn {settings.solver} produced a non-finite {name.replace('_', ' ')} at "
+            raise NonFiniteSolve(f"Exudyn {settings.solver} produced a non-finite {name.replace('_', ' ')} at "
                                   f"t = {data[first, 0]:.6g} s (the solve diverged; try a smaller step or "
                                   "tighter tolerance)")
     time = columns["barrel_position"][:, 0]

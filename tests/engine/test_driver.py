@@ -101,3 +101,50 @@ def test_solves_run_with_exudyns_throw_on_ctrl_c_and_restore_it(monkeypatch):
     before = exudyn.special.solver.throwErrorWithCtrlC
     simulate(simplified_model(), 0.5)
     assert seen and all(seen) and exudyn.special.solver.throwErrorWithCtrlC == before
+
+
+def test_a_diverged_adaptive_solve_is_re_solved_with_a_quarter_of_the_max_step(monkeypatch):
+    """The realistic base with a damper 1000x the paper's (a time constant of ~0.1 ms): a 40 ms trial step from the
+    slow phase into it reaches states where the battery stop's force is not finite, and Exudyn accepts it (its error
+    estimate is NaN).  The run is re-solved with max_step / 4 and then agrees with the independent reference (the
+    cradle's friction regularisation is the residual, ~1e-5: DESIGN.md, "Inclined cradle")."""
+    from dataclasses import replace
+    from pathlib import Path
+
+    import mbs_models.engine.driver as driver
+    from mbs_models.engine.accuracy import ACCURACY_PRESETS
+    from mbs_models.scene.io import load_scene
+    from mbs_models.studies.brake_design import PAPER_DAMPER
+    from validation.reference import solve_reference
+
+    base = load_scene(Path(__file__).resolve().parents[2] / "scripts" / "realistic_base.toml")
+    scene = base.with_changes(recoil_brake=None, recoil_damper=replace(
+        PAPER_DAMPER, recoil=PAPER_DAMPER.recoil * 1e3, counter_recoil=PAPER_DAMPER.counter_recoil * 1e3))
+    solves = []
+    original = driver._solve
+    monkeypatch.setattr(driver, "_solve", lambda assembly, settings, *a, **k: (solves.append(settings.max_step),
+                                                                               original(assembly, settings, *a, **k))[1])
+    result = simulate(scene, 0.5, "standard")
+    preset = ACCURACY_PRESETS["standard"].max_step
+    assert result.settings.max_step == preset / 4 and preset in solves
+    ref = solve_reference(scene, 0.5)
+    assert result.max_barrel_displacement == pytest.approx(ref.max_barrel_displacement, rel=1e-4)
+    assert result.peak_support_force == pytest.approx(ref.peak_support_force, rel=1e-4)
+
+
+def test_a_segment_ending_a_round_off_short_of_its_end_ends_at_it():
+    """0.5 s + 7 steps of 0.25/7 s sum to 0.7499999999999999 s: the next segment (a shot at 0.75 s) must share the
+    time, so the last time becomes 0.75 s; a segment stopped early (by the tracker) keeps its times."""
+    import numpy as np
+
+    from mbs_models.engine.driver import _ending_at
+
+    steps = np.array([0.5] + [0.25 / 7] * 7)
+    time = np.cumsum(steps)
+    assert time[-1] != 0.75 and abs(time[-1] - 0.75) < 1e-15
+    values = {"x": np.arange(8.0)}
+    snapped, same = _ending_at((time, values), 0.75)
+    assert snapped[-1] == 0.75 and np.array_equal(snapped[:-1], time[:-1]) and same is values
+    assert time[-1] != 0.75  # the solver's array itself is not changed
+    early = np.array([0.5, 0.6, 0.7])
+    assert np.array_equal(_ending_at((early, values), 0.75)[0], early)

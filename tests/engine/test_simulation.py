@@ -229,16 +229,16 @@ def test_a_scene_without_contact_is_stopped_by_the_step_budget_naming_its_stiff_
 
 
 def test_stored_samples_are_capped_and_a_run_beyond_the_cap_fails_saying_so(monkeypatch):
-    """Model (ii) stores seven sensors; with room for 200 samples a 2 s draft run (some 270 steps) fails naming the
+    """Model (ii) stores seven sensors; with room for 100 samples a 2 s draft run (some 140 steps) fails naming the
     cap, with room for 2000 it passes holding fewer samples than the cap."""
     import mbs_models.engine.guard as guard
 
     scene = model_ii(1000.0, 0.0)
     monkeypatch.setattr(guard, "MAX_STORED_VALUES", 7 * 2000)
     result = simulate(scene, 2.0, "draft")
-    assert 200 < len(result.time) <= 2000 and result.steps <= 2000
-    monkeypatch.setattr(guard, "MAX_STORED_VALUES", 7 * 200)
-    with pytest.raises(SimulationError, match="reached its cap of 200 samples"):
+    assert 100 < len(result.time) <= 2000 and result.steps <= 2000
+    monkeypatch.setattr(guard, "MAX_STORED_VALUES", 7 * 100)
+    with pytest.raises(SimulationError, match="reached its cap of 100 samples"):
         simulate(scene, 2.0, "draft")
 
 

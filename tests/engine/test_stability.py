@@ -10,6 +10,7 @@ refused at once instead of hanging; a grazing touch stepped over between two ste
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 import time
 import warnings
 
@@ -307,9 +308,11 @@ def test_fixed_step_that_steps_over_a_grazing_contact_raises():
 
 
 def test_adaptive_solver_re_solves_a_stepped_over_contact():
+    """draft's tolerances with a 10 ms max step step over the 0.6 ms graze (at the preset's own max step the first
+    solve feels it, and the grazing rule re-solves it)."""
     scene = model_ii(1000.0, 0.2214770 - 5e-8).with_changes(**{"contact.stiffness": 1e12})
     ref = solve_reference(scene, 1.0, max_step=1e-3)
-    result = simulate(scene, 1.0, "draft")
+    result = simulate(scene, 1.0, replace(ACCURACY_PRESETS["draft"], max_step=1e-2))
     assert result.settings.max_step < 1e-3
     assert result.peak_contact_force == pytest.approx(ref.peak_contact_force, rel=1e-2)
     assert result.impacts == [] and ref.impacts == []
