@@ -29,8 +29,8 @@ EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
 #: What the accuracy presets mean (mbs_models.engine.accuracy.ACCURACY_PRESETS: the worst relative error of
 #: the max barrel displacement stated there, and the time relative to draft).
 ACCURACY_HELP = ("solver accuracy (default: standard): draft = fast, for plots and exploration (max barrel "
-                 "displacement within 1e-4); standard = results (1e-7, ~1.4x draft's time); reference = "
-                 "validation (1e-9, ~1.8x)")
+                 "displacement within 1e-4); standard = results (1e-7, ~1.3x draft's time); reference = "
+                 "validation (1e-9, ~2.9x)")
 _ARGUMENT_NAMES = {"end_time": "--end-time", "accuracy": "--accuracy", "impact_threshold": "--impact-threshold",
                    "user_functions": "--user-functions"}
 
