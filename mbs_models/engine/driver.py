@@ -13,6 +13,9 @@
   :data:`MAX_DIVERGENCE_RETRIES` times): a trial step as long as the maximum step, taken from a slow phase into a
   stiff one (a damper of a millisecond's time constant), can reach states where a law is not finite, and Exudyn
   accepts a step whose error estimate is NaN;
+* stalled with a maximum step above :data:`~mbs_models.engine.stability.GRAZING_MAX_STEP`: once with that
+  maximum step (a long accepted step can land where the step size then collapses: the planar jump of the hard
+  cases at 20 ms);
 * stalled on Exudyn's error-scale bug with absolute error control (:func:`_absolute_tolerance_settings`, once).
 
 What it collected is a :class:`Solve`; what the run *means* (why it stopped, which metrics are final) is the run
@@ -529,6 +532,10 @@ def drive(models: FreshModels, scene: Scene, policy: RunPolicy) -> Solve:
             settings = replace(settings, max_step=settings.max_step / 4.0)
             continue
         except _StepSizeStalled as stalled:
+            if settings.adaptive and settings.max_step > stability.GRAZING_MAX_STEP:
+                # first with the fine max step (a long step can land where the step then collapses), then below
+                settings = replace(settings, max_step=stability.GRAZING_MAX_STEP)
+                continue
             retry = _absolute_tolerance_settings(settings) if settings.adaptive else None
             if retry is None:
                 raise SimulationError(str(stalled)) from None

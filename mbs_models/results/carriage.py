@@ -15,8 +15,11 @@ applied, evaluated at the samples' states):
   and dissipated energy (``integral -(T u + N y') dt - (U - U(0))``, Gauss quadrature on the Hermite-interpolated
   state) and the work of a load on its body, ``integral F (x_i' - v_c . e') dt`` (its power ``Q . q'``).
 
-Minima and the lift-off are taken at the output samples (no refinement between steps: the support forces
-vary on the carriage's time scales, not an impact's; stated, and compared with the reference).
+The maxima of the motion (``max_carriage_pitch``, ``max_lift``, ``max_carriage_displacement``) are refined on
+the cubic Hermite interpolant of the carriage's coordinates between the samples (:mod:`mbs_models.results.peaks`),
+as the 1-D metrics are: the presets' maximum step leaves samples far apart where the carriage moves slowly.  The
+support forces' minima (the stability margin) and the lift-off are taken at the output samples (the support
+forces vary on the carriage's time scales, not an impact's; stated, and compared with the reference).
 """
 
 from __future__ import annotations
@@ -31,6 +34,7 @@ from ..elements.carriage import (AxisBody, StaticState, elevation_of, gravity_of
 from ..elements.ops import NUMPY_OPS
 from ..errors import SimulationError
 from .energies import _GL_NODES, cumulative_quadrature
+from .peaks import refine_function_maximum, refine_maximum
 from .samples import Interpolant, Samples
 
 _COORDINATES = ("carriage_x", "carriage_y", "carriage_pitch")
@@ -183,13 +187,27 @@ def carriage_output(mechanism, s: Samples, interp: Interpolant, energies=None) -
         loads = ", ".join(f"{o.name} {o.static_normal_force:.3g} N" for o in supports.values())
         raise SimulationError(f"the stability margin (least load / static load) is beyond double precision: the "
                               f"static loads ({loads}) are too small against the loads of the run")
-    heights = np.concatenate([o.height for o in supports.values()])
+    coordinates = Interpolant(_coordinate_samples(s))
+
+    def refined(sampled: np.ndarray, of_time) -> float:
+        """The largest |value| of a sampled quantity, refined near its largest sample on ``of_time(t)`` (the same
+        quantity on the interpolated coordinates, sign included)."""
+        k = int(np.argmax(np.abs(sampled)))
+        sign = 1.0 if sampled[k] >= 0 else -1.0
+        value, _ = refine_function_maximum(lambda times: sign * of_time(coordinates.state(times)[0]), t, k)
+        return float(max(abs(sampled[k]), value))
+
+    pitch = np.asarray(q["carriage_pitch"]) - static.pitch
+    rate = np.asarray(v["carriage_pitch"])
+    max_pitch = max(refine_maximum(t, pitch, rate)[0], refine_maximum(t, -pitch, -rate)[0])
+    lifts = [refined(np.maximum(o.height, 0.0), lambda c, r=support.position: geometry.point(c, r)[1])
+             for o, support in zip(supports.values(), carriage.supports)]
+    displacement = refined(cg[:, 0] - static_cg[0],
+                           lambda c: geometry.point(c, carriage.center_of_mass)[0] - static_cg[0])
     output = CarriageOutput(position=cg, pitch=np.asarray(q["carriage_pitch"]), static_pitch=static.pitch,
-                            supports=supports,
-                            max_carriage_pitch=float(np.max(np.abs(q["carriage_pitch"] - static.pitch))),
-                            max_lift=float(max(0.0, np.max(heights))), lift_off_time=lift_off,
-                            max_carriage_displacement=float(np.max(np.abs(cg[:, 0] - static_cg[0]))),
-                            stability_margin=float(margin))
+                            supports=supports, max_carriage_pitch=float(max_pitch),
+                            max_lift=float(max(0.0, *lifts)), lift_off_time=lift_off,
+                            max_carriage_displacement=displacement, stability_margin=float(margin))
     if energies is not None:
         _planar_energies(mechanism, geometry, static, s, interp, q, v, supports, energies)
     return output
