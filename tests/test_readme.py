@@ -55,3 +55,13 @@ def test_the_readme_is_short_and_keeps_the_two_commands():
     assert len(text.splitlines()) <= 200
     assert "bash scripts/test.sh " in text and "bash scripts/paper.sh --out out" in text
     assert "bash scripts/test.sh" in (README.parent / ".ci" / "run").read_text()
+
+
+def test_the_readmes_links_and_figure_resolve():
+    """Every relative link and image of the README names a file of the repository.  The documentation site's pages
+    of another part (docs/theory, validation, performance, reference) are only required once that part is there."""
+    root = README.parent
+    targets = re.findall(r"\]\(((?!https?://)[^)#\s]+)\)", README.read_text())
+    assert "docs/figures/two_absorbers.png" in targets
+    missing = [t for t in targets if not (root / t).exists()]
+    assert [t for t in missing if (root / Path(t).parent).is_dir() or not t.startswith("docs/")] == []

@@ -39,7 +39,7 @@ end stops): ``law`` (default ``hunt-crossley``) and the law's fields above; fiel
 errors.  Python: ``Contact(gap=0.0, stiffness=2.1e8, exponent=1.3, damping_factor=0.6)``.
 
 Building block: :func:`add_contact` adds a contact of any law between two markers of a caller's own
-Exudyn system (symbolic user function by default); see the README.
+Exudyn system (symbolic user function by default); see the user guide (docs/guide/building-blocks.md).
 """
 
 from __future__ import annotations

@@ -39,8 +39,8 @@ from .time_scales import time_scale_hint
 #: Re-solves (with max_step / 4 each) when an adaptive solver stepped over a whole contact.
 MAX_CONTACT_RETRIES = 3
 #: The finality tracker (stop_when_final) is shown the state at every this-many-th step: an observed step's
-#: pre-step call (reading the state, the bounds) costs ~10 us inside a solve, a step ~5 us (README, cost
-#: section; scripts/bench_prestep.py).  Changing it changes when early stops happen (not bit-identical).
+#: pre-step call (reading the state, the bounds) costs ~10 us inside a solve, a step ~5 us (the performance
+#: pages; scripts/bench_prestep.py).  Changing it changes when early stops happen (not bit-identical).
 OBSERVE_EVERY = 4
 #: Most output samples kept for fixed-step solvers (output is thinned beyond this, and beyond
 #: :func:`~mbs_models.engine.guard.sample_cap` for a scene with many sensors).
@@ -133,7 +133,7 @@ def _pre_step_function(assembly: Assembly, budget: StepBudget | None, tracker: F
     at :attr:`~mbs_models.engine.guard.StepBudget.next_check`) and the tracker's cadence; the state is read
     only for the captures or an observed step, and passed on as it is where Exudyn's coordinates are the
     bodies in body order (else reordered).  With the budget alone (most adaptive solves) the function only
-    counts: one Python call, an increment and a comparison per step (~0.2 us; README, "Limits").
+    counts: one Python call, an increment and a comparison per step (~0.2 us; the validation pages, "Limits").
     """
     data = assembly.mbs.systemData
     read_positions, read_velocities = data.GetODE2Coordinates, data.GetODE2Coordinates_t

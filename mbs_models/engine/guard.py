@@ -27,7 +27,7 @@ Fixed-step solvers take the number of steps they are given (at most ``stability.
 Cost: the engine's pre-step function counts the steps itself and calls :meth:`StepBudget.advance` only at
 the budget's checkpoints (:attr:`StepBudget.next_check`: every :data:`STALL_WINDOW_STEPS`-th step and the
 budget's end), so a step pays one Python call with an integer increment and a comparison (about 0.2 us;
-README, "Limits").
+the validation pages, "Limits").
 """
 
 from __future__ import annotations

@@ -30,7 +30,7 @@ PAPER_ROUNDED_INITIAL_VELOCITY = 0.7
 
 @dataclass(frozen=True)
 class Conventions:
-    """Alternative readings of the paper's text; all off by default (see the README and the report).
+    """Alternative readings of the paper's text; all off by default (see the user guide and the report).
 
     Each flag reproduces one literal reading that the validation report studies.  They concern the
     paper's contact at wall A (the absorbers' contacts):

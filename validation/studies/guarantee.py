@@ -1,7 +1,7 @@
-"""What the README guarantees per accuracy preset, and the checks of an engine result behind it.
+"""What the documentation guarantees per accuracy preset, and the checks of an engine result behind it.
 
-The README's "What is guaranteed" section states, per preset, the largest errors of an engine result
-against the independent reference (:data:`TOLERANCES`); ``tests/test_readme.py`` keeps the README's
+The user guide's accuracy page (docs/guide/accuracy.md) states, per preset, the largest errors of an engine
+result against the independent reference (:data:`TOLERANCES`); ``tests/docs/test_guide_pages.py`` keeps its
 table equal to this dictionary, and the hard cases and property tests check every result with
 :func:`errors_against_reference`, :func:`violations` and :func:`physical_violations`.
 """
@@ -16,7 +16,7 @@ import numpy as np
 from ..reference import solve_reference
 
 #: Largest errors accepted per preset: a margin over the maxima measured on the hard cases and on the
-#: random scenes of the property tests (the README's "What is guaranteed" states them).
+#: random scenes of the property tests (the validation pages' "What is guaranteed" states them).
 #:
 #: * ``energy``: max over the run of |kinetic + stored + dissipated - initial energy| / initial energy;
 #: * ``metric``: relative error of the max barrel displacement and the max absorber velocity, and the
