@@ -5,7 +5,7 @@
 # Extra arguments pass through to sphinx-build (e.g. -E to re-read every page).
 source "$(dirname "${BASH_SOURCE[0]}")/_setup.sh"
 DOCS_STAMP=.venv/.recoil-docs-installed
-if [ ! -f "$DOCS_STAMP" ] || [ pyproject.toml -nt "$DOCS_STAMP" ]; then
+if [ ! -f "$DOCS_STAMP" ] || [ pyproject.toml -nt "$DOCS_STAMP" ] || [ "$LOCK" -nt "$DOCS_STAMP" ]; then
     echo "[docs] installing the docs extra into .venv" >&2
     "$VENV_PYTHON" -m pip install --quiet --disable-pip-version-check "${CONSTRAINTS[@]}" -e ".[docs]"
     touch "$DOCS_STAMP"
