@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Set-up + the documentation site: install the project with its `docs` extra (Sphinx, the theme, MyST, the
-# gallery, numpydoc, a bundled MathJax) into .venv as scripts/_setup.sh does for the tests, then build
-# docs/_build/html with every warning an error.  The gallery's examples run during the build.
+# gallery, a bundled MathJax; sphinx.ext.napoleon reads the docstrings) into .venv as scripts/_setup.sh does for
+# the tests, then build docs/_build/html with every warning an error.  The gallery's examples run during the build.
 # Extra arguments pass through to sphinx-build (e.g. -E to re-read every page).
 source "$(dirname "${BASH_SOURCE[0]}")/_setup.sh"
 DOCS_STAMP=.venv/.recoil-docs-installed
