@@ -153,6 +153,10 @@ class Table:
         :data:`~mbs_models.elements.declaration.END_STOP`); none by default.
     OUTPUTS: the element's declared histories and metrics (:mod:`~mbs_models.elements.declaration`); none by
         default.
+    KEY_UNITS: field name -> unit of a key whose ``RULES`` entry names none (``"1"`` dimensionless, ``"text"``,
+        ``"true/false"``, the form of a table of pairs); with the ``Attributes`` section of the class docstring
+        (one entry per key) it makes the key reference (:mod:`mbs_models.scene.keys`).
+    CHOICES: field name -> the allowed strings of a key that is a choice (the tuple its check uses).
     """
 
     TABLE: ClassVar[str] = ""
@@ -164,6 +168,8 @@ class Table:
     NESTED_MANY: ClassVar[dict[str, type]] = {}
     ROLES: ClassVar[tuple[str, ...]] = ()
     OUTPUTS: ClassVar[Outputs] = NO_OUTPUTS
+    KEY_UNITS: ClassVar[dict[str, str]] = {}
+    CHOICES: ClassVar[dict[str, tuple[str, ...]]] = {}
 
     def __post_init__(self):
         for name, rule in self.RULES.items():

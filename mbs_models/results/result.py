@@ -81,7 +81,7 @@ class Result:
     use the dictionaries).
 
     Metrics (refined between output samples, see :mod:`mbs_models.results.peaks`):
-    ``max_barrel_displacement`` (m, Table 2) and its time; ``peak_support_force`` (largest |S|, N) and its
+    ``max_barrel_displacement`` (m, Table 2) and its time; ``peak_support_force`` (largest ``|S|``, N) and its
     time; ``peak_contact_force`` (N) and ``max_absorber_velocity`` (m/s), the largest over all absorbers,
     with their times; ``impacts`` (all absorbers' impacts in time order); ``dissipated_energy`` (J per
     dissipating connector at the end time); :meth:`absorbers`, :meth:`stops`, :meth:`energy` per element.
