@@ -5,7 +5,8 @@
     python scripts/docs_numbers.py --write    # ... and write docs/_generated/numbers.json (committed)
 
 Every ``docs/numbers_<area>.py`` defines ``NUMBERS = {name: {"compute": callable -> float, "format": "{:.1f} kN",
-"rel_tol": float, "why": "what the number is"}}``.  A page quotes a number as the MyST substitution
+"rel_tol": float, "why": "what the number is"}}`` (optionally ``"abs_tol"``: an absolute bound for a number near
+zero; stale means farther than ``max(rel_tol * |value|, abs_tol)``).  A page quotes a number as the MyST substitution
 ``{{ name }}``; ``docs/conf.py`` loads the JSON's texts, so the build never simulates for numbers, and
 ``tests/docs/test_numbers.py`` recomputes every entry and fails on a stale value, an unknown name or an unused entry.
 """
