@@ -109,7 +109,6 @@ for stop in result.stops():
 #
 # Where the energy goes
 # ---------------------
-# ---------------------
 # Every element reports its kinetic, stored and dissipated energy; with the work of the breech force they
 # balance. The brake dissipates the recoil's energy, the recuperator stores some of it and gives it back
 # on the return, and the buffer takes what is left of the return.

@@ -30,6 +30,7 @@ from mbs_models.scenes import scene_path
 outputs = tempfile.TemporaryDirectory(prefix="recoil-gallery-")   # removed at the end
 work = Path(outputs.name)
 main(["design-brake", "simplified", "--recoil-length", "0.2215", "--out", str(work / "brake")])
+plt.close("all")   # the command's own figure went to design_brake.png; we draw ours below
 numbers = json.loads((work / "brake" / "design_brake.json").read_text())
 designed = load_scene(work / "brake" / "designed.toml")
 print(f"\nconstant resistance R = {numbers['constant_resistance'] / 1e3:.3f} kN; the designed orifice: "
@@ -40,9 +41,9 @@ print(f"\nconstant resistance R = {numbers['constant_resistance'] / 1e3:.3f} kN;
 # The resistance over the stroke
 # ------------------------------
 # The force on the mount against the barrel's displacement during the recoil: the designed brake holds it
-# flat, while the linear damper's force peaks at the start (the velocity is largest) and the spring's at the
-# end. At the same recoil length the flat curve has the smaller peak: the area under each curve is the same
-# recoil energy.
+# flat. With the linear damper it starts at the damper's ``c v0`` and grows as the spring's ``k x`` adds up
+# faster than the damper's share falls, peaking late in the stroke. The area under each curve is the same
+# recoil energy, so at the same recoil length the flat curve has the smaller peak.
 runs = {"designed brake": simulate(designed, 3.0), "paper's linear damper": simulate(simplified_model(), 3.0)}
 fig, ax = plt.subplots(figsize=(7, 3.5), layout="constrained")
 for label, result in runs.items():
@@ -66,6 +67,7 @@ ax.legend()
 # (``--max-recoil``, 1 m by default, which the scene's other elements cut short: the note it prints).
 main(["design-brake", "towed_howitzer", "--stable", "--elevations", "0,15,30,45", "--bands", "20",
       "--accuracy", "draft", "--out", str(work / "stable")])
+plt.close("all")
 stable = load_scene(work / "stable" / "designed.toml")
 for band in stable.recoil_brake.band:
     counter = band.counter_recoil_orifice_area

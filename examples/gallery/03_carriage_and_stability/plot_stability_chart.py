@@ -32,16 +32,17 @@ from mbs_models.studies.stability_chart import stability_chart, summary_lines
 
 scene = load_scene(scene_path("towed_howitzer"))
 start = time.perf_counter()
-points = stability_chart(scene, [0.0, 10.0, 20.0, 30.0, 40.0, 50.0, 55.0], margin=0.8, end_time=3.0,
-                         accuracy="draft")
+elevations = [0.0, 3.0, 6.0, 9.0, 12.0, 15.0, 17.0, 20.0, 30.0, 40.0, 50.0, 55.0]   # finer where the limit lives
+points = stability_chart(scene, elevations, margin=0.8, end_time=3.0, accuracy="draft")
 print("\n".join(summary_lines(points)))
 print(f"({len(points)} elevations in {time.perf_counter() - start:.1f} s)")
 
 # %%
 # Reading the chart
 # -----------------
-# The closed form's limit rises steeply with the elevation (the arm ``h`` shrinks and then changes sign: from
-# there on the recoil presses the front down, and any recoil is stable). The simulated peak resistance stays
+# The closed form's limit rises steeply with the elevation: the recoil axis' arm ``h`` about the spade
+# shrinks to zero where the axis points straight at the spade's tip, and beyond that elevation the pull
+# presses the front down and any recoil is stable ("none" and "any" in the table). The simulated peak resistance stays
 # far below the limit at every elevation: the shipped brake never tips the gun *during the recoil*. The
 # simulated stability margin still reaches 0 at low elevations, on *counter-recoil*: the buffer that stops
 # the returning barrel pushes the gun forward about its wheels. The columns ``recoil: sim/cf`` compare the

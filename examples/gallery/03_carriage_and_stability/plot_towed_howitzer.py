@@ -36,8 +36,8 @@ ax.plot(*carriage.center_of_mass, "ks", label="carriage CG")
 for scene, style in ((level, "-"), (raised, "--")):
     theta = math.radians(scene.cradle.elevation)
     tx, ty = scene.carriage.trunnion
-    ax.plot([tx - 3.0 * math.cos(theta), tx + 3.0 * math.cos(theta)],
-            [ty - 3.0 * math.sin(theta), ty + 3.0 * math.sin(theta)], "k" + style, lw=1,
+    ax.plot([tx - 1.5 * math.cos(theta), tx + 3.0 * math.cos(theta)],      # breech side ... muzzle side
+            [ty - 1.5 * math.sin(theta), ty + 3.0 * math.sin(theta)], "k" + style, lw=1,
             label=f"recoil axis at {scene.cradle.elevation:g} deg")
 ax.plot(*carriage.trunnion, "ro", label="trunnion")
 ax.axhline(0.0, color="saddlebrown", lw=2)

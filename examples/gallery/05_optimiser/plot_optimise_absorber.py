@@ -5,7 +5,7 @@ Optimising an absorber within bounds
 Which absorber moderates the force on the mount most without lengthening the recoil? ``optimise`` (the CLI's
 ``recoil optimise``) searches the design space with scipy's differential evolution: bounded and global, with
 no gradient, because the metrics are not smooth in the gap (an impact comes or goes). Constraints on any
-metric are scipy ``NonlinearConstraint``s, not penalties: a feasible design always beats an infeasible one.
+metric are scipy ``NonlinearConstraint`` objects, not penalties: a feasible design always beats an infeasible one.
 """
 
 # %%

@@ -22,7 +22,10 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
-EXAMPLES = Path(__file__).resolve().parents[2]          # examples/, where the user's module lives
+try:  # examples/, where the user's module lives
+    EXAMPLES = Path(__file__).resolve().parents[2]
+except NameError:  # sphinx-gallery runs the script without __file__, in the script's own folder
+    EXAMPLES = Path.cwd().resolve().parents[1]
 sys.path.insert(0, str(EXAMPLES))
 import progressive_spring  # noqa: E402  (registers [progressive_spring])
 

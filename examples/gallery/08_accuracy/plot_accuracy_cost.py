@@ -74,7 +74,7 @@ for label, (errors, seconds) in rows.items():
 # margin read at the output samples).
 fig, ax = plt.subplots(figsize=(7, 4.5), layout="constrained")
 for metric in METRICS:
-    ax.loglog([1e3 * rows[label][1] for label in SETTINGS], [max(rows[label][0][metric], 1e-16) for label in SETTINGS],
+    ax.semilogy([1e3 * rows[label][1] for label in SETTINGS], [max(rows[label][0][metric], 1e-16) for label in SETTINGS],
               "o-", label=metric)
 for label in SETTINGS:
     errors, seconds = rows[label]
