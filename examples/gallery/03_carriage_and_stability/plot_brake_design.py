@@ -65,7 +65,7 @@ ax.legend()
 # support's static load. Here two bands, up to 20 degrees and above, at ``draft`` accuracy. Above 20 degrees
 # the recoil presses the front down and any length is stable: that band recoils as long as it may
 # (``--max-recoil``, 1 m by default, which the scene's other elements cut short: the note it prints).
-main(["design-brake", "towed_howitzer", "--stable", "--elevations", "0,15,30,45", "--bands", "20",
+main(["design-brake", "towed_howitzer", "--stable", "--elevations", "0,10,40", "--bands", "20",
       "--accuracy", "draft", "--out", str(work / "stable")])
 plt.close("all")
 stable = load_scene(work / "stable" / "designed.toml")
