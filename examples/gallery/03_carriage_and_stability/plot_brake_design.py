@@ -30,7 +30,7 @@ from mbs_models.scenes import scene_path
 outputs = tempfile.TemporaryDirectory(prefix="recoil-gallery-")   # removed at the end
 work = Path(outputs.name)
 main(["design-brake", "simplified", "--recoil-length", "0.2215", "--out", str(work / "brake")])
-plt.close("all")   # the command's own figure went to design_brake.png; we draw ours below
+# the command wrote its own figure to design_brake.png; we draw ours below
 numbers = json.loads((work / "brake" / "design_brake.json").read_text())
 designed = load_scene(work / "brake" / "designed.toml")
 print(f"\nconstant resistance R = {numbers['constant_resistance'] / 1e3:.3f} kN; the designed orifice: "
