@@ -67,8 +67,9 @@ napoleon_custom_sections = [("Class attributes", "params_style")]
 
 # ---------------------------------------------------------------- the gallery (examples/gallery, run at build time)
 sphinx_gallery_conf = {
-    "examples_dirs": str(ROOT / "examples" / "gallery"),
-    "gallery_dirs": str(DOCS / "auto_examples"),
+    "examples_dirs": "../examples/gallery",      # relative to docs/ (sphinx-gallery writes sub-gallery toctrees
+                                                 # from these paths: absolute ones break them)
+    "gallery_dirs": "auto_examples",
     "filename_pattern": r"/plot_",
     "abort_on_example_error": True,
     "only_warn_on_example_error": False,
