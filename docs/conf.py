@@ -80,13 +80,14 @@ sphinx_gallery_conf = {
     "default_thumb_file": None,
     "show_memory": False,
     "plot_gallery": "True",
+    "capture_repr": (),          # a cell's last expression (a Legend, a list of lines) is not printed as output
 }
 
 # ---------------------------------------------------------------- HTML
 html_theme = "pydata_sphinx_theme"
 html_title = "recoil-mbs"
 html_static_path = ["_static"]
-html_css_files = ["recoil.css"]
+html_js_files = ["recoil.js"]           # gallery figures open full size on click
 html_show_sourcelink = False
 html_theme_options = {
     "navigation_with_keys": False,
