@@ -36,7 +36,7 @@ import numpy as np
 
 from mbs_models import model_i, model_ii, simplified_model, simulate
 from mbs_models.scene.models import model_i as _model_i_doc, model_ii as _model_ii_doc, simplified_model as _simp_doc
-from mbs_models.outputs import atomic_write_json, atomic_write_text, prepare_output_dir
+from mbs_models.outputs import atomic_write_json, atomic_write_text, check_output_dir, prepare_output_dir
 from mbs_models.scene import Scene
 from mbs_models.studies.sweep import default_workers, process_pool, run_sweep_jobs, sweep_jobs
 
@@ -1192,7 +1192,7 @@ def results_json(data: dict) -> dict:
 
 def write_report(out: str | Path, options: ReportOptions = ReportOptions(), progress: Progress = _silent) -> dict:
     """Compute everything and write ``report.html``, ``results.json``, ``table2.md/json`` and PNGs to ``out``."""
-    out = prepare_output_dir(out)
+    check_output_dir(out)   # a bad directory: SceneError before any work; created once there is something to write
     start = time.perf_counter()
     data = compute_report(options, progress)
     progress("figures and report")
@@ -1201,6 +1201,7 @@ def write_report(out: str | Path, options: ReportOptions = ReportOptions(), prog
     pngs = make_figures(data, options.workers)
     data["timings"]["figures (wall)"] = time.perf_counter() - figures_start
     from mbs_models.outputs import atomic_write_bytes
+    out = prepare_output_dir(out)
     for name, png in pngs.items():
         atomic_write_bytes(out / f"{name}.png", png)
     rows = table2_rows(data)

@@ -239,7 +239,7 @@ def page_problems(html_text: str) -> list[str]:
 
 @pytest.fixture(scope="module")
 def report_dir(tmp_path_factory):
-    out = tmp_path_factory.mktemp("report")
+    out = tmp_path_factory.mktemp("report") / "new" / "directory"   # missing directories are created
     write_report(out, ReportOptions.reduced())
     return out
 
