@@ -269,7 +269,7 @@ def plot_map(table, x: str, hue: str, y: str = "max_barrel_displacement", *, lev
     fig.colorbar(mesh, ax=ax, label=y_label)
     gx, gh = np.meshgrid(xs, hs)
     drawn = ~np.ma.getmaskarray(values)
-    ax.plot(gx[drawn], gh[drawn], "o", color="white", mec="black", ms=3.5, mew=0.6, ls="none")
+    ax.plot(gx[drawn], gh[drawn], "o", color="white", mec="black", ms=3.5, mew=0.6, ls="none", clip_on=False)
     ax.set_xlim(x_edges[0], x_edges[-1])
     ax.set_ylim(h_edges[0], h_edges[-1])
     contours = None
@@ -284,8 +284,13 @@ def plot_map(table, x: str, hue: str, y: str = "max_barrel_displacement", *, lev
         if values.count() <= 100:
             for (i, j), value in np.ndenumerate(values.filled(np.nan)):
                 if np.isfinite(value):
-                    ax.annotate(f"{value:.4g}", (xs[j], hs[i]), xytext=(0, 4), textcoords="offset points",
-                                ha="center", va="bottom", fontsize=7, color="white")
+                    # inside its cell: the label of a point on the map's edge points inwards
+                    left, right = j == 0 and len(xs) > 1, j == len(xs) - 1 and len(xs) > 1
+                    top = i == len(hs) - 1 and len(hs) > 1
+                    ax.annotate(f"{value:.4g}", (xs[j], hs[i]), xytext=(4 * left - 4 * right, -5 if top else 5),
+                                textcoords="offset points", ha="left" if left else "right" if right else "center",
+                                va="top" if top else "bottom", fontsize=7, color="white",
+                                path_effects=[patheffects.withStroke(linewidth=2, foreground="black")])
     ax.set_xlabel(x_label)
     ax.set_ylabel(h_label)
     ax.set_title(title or f"{y.replace('_', ' ')} over {x} and {hue}", fontsize=11)
