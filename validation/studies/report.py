@@ -915,6 +915,7 @@ ENGINE_REFERENCE_COLUMNS = (("max_barrel_displacement", "x_max"), ("time_of_max_
                             ("peak_support_force", "peak support force"), ("peak_contact_force", "peak contact force"),
                             ("max_absorber_velocity", "v_max absorber"),
                             ("time_of_max_absorber_velocity", "t(v_max absorber)"),
+                            ("time_to_battery", "t(battery)"),
                             ("barrel_position_history", "x_M(t)"), ("absorber_position_history", "x_m(t)"))
 
 
