@@ -310,7 +310,7 @@ class Result:
     @property
     def time_to_battery(self) -> float | None:
         """A single shot's return (s after the shot at t = 0): the first time ``t >= t_max`` at which the barrel is
-        back within ``BATTERY_TOLERANCE`` (1 mm) of its position at t = 0,
+        back within :data:`~mbs_models.results.battery.BATTERY_TOLERANCE` (1 mm) of its position at t = 0,
 
             ``x_M(t) <= x_M(0) + 1e-3 m``,  ``t_max`` = :attr:`time_of_max_barrel_displacement`,
 
@@ -318,23 +318,13 @@ class Result:
         ``time_to_battery`` of a burst; ``t_max`` itself when the maximum is within 1 mm).  None with a burst
         (each shot's is in ``shots``), when the maximum is not reported (an early stop that did not prove it) or
         is the end of the window, or when the barrel is not back within the window."""
-        from ..elements.firing import BATTERY_TOLERANCE
-        from .peaks import HermiteTrajectory, refine_crossing
+        from .battery import return_to_battery
 
         if getattr(self.scene, "burst", None) is not None or self.max_barrel_displacement is None \
                 or self.max_at_end_of_window:
             return None
-        t, x = self.time, self.barrel_position
-        level = float(x[0]) + BATTERY_TOLERANCE
-        t_max = self.time_of_max_barrel_displacement
-        if self.max_barrel_displacement <= level:
-            return float(t_max)
-        back = np.flatnonzero((t > t_max) & (x <= level))
-        if not len(back):
-            return None
-        j = int(back[0])
-        path = HermiteTrajectory(t, x, self.barrel_velocity)
-        return refine_crossing(lambda times: path(times) <= level, max(float(t[j - 1]), t_max), float(t[j]))
+        return return_to_battery(self.time, self.barrel_position, self.barrel_velocity,
+                                 self.time_of_max_barrel_displacement, self.max_barrel_displacement)
 
     def maxima_at_end_of_window(self) -> list[str]:
         """The peak metrics whose maximum is the window's last instant (still rising there, so not a turning
