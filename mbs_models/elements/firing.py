@@ -364,8 +364,7 @@ class BreechForce(Load):
         return self._windows[-1][1]
 
 
-#: A barrel within this distance (m) of its position before the first shot is "in battery".
-BATTERY_TOLERANCE = 1.0e-3
+from ..results.battery import BATTERY_TOLERANCE  # noqa: E402  (1 mm: "in battery", as a single shot's return)
 
 
 def shot_outputs(run) -> list[dict]:
