@@ -245,20 +245,30 @@ def print_before(out: dict) -> None:
     rows = [("complete standard run, model (ii) 10 s (wall)", "run wall", 1 / 1.6),
             ("complete standard run (CPU)", "run cpu", 1 / 1.6),
             (f"early-stopped sweep point, CPU per point ({out['points']} points)", "point cpu", 1 / 1.5),
+            ("fixed cost of a call: a 1 ms standard run (CPU)", "call cpu", None),
+            ("the compression_only reading's engine runs, recoil paper (CPU)", "reading cpu", None),
             ("import to the first result (in the interpreter)", "import", None),
             ("import to the first result (process wall)", "import process", None),
             ("import to the first result (process CPU, user + system)", "import process cpu", None)]
     for name, key, target in rows:
+        if key not in now or key not in before:
+            continue
         ratio = now[key] / before[key]
         verdict = "" if target is None else \
             f"  target <= {target:.3f} ({1 / target:g}x faster): {'met' if ratio <= target else 'NOT met'}"
         print(f"   {name:58s} now/before {ratio:6.3f}  [{ms(now[key])} vs {ms(before[key])}]{verdict}")
+    if "paper cpu" in now:
+        ratio = now["paper cpu"] / before["paper cpu"]
+        print(f"   {'full recoil paper --workers 1 (CPU s, user + system)':58s} now/before {ratio:6.3f}  "
+              f"[{now['paper cpu']:.1f} s vs {before['paper cpu']:.1f} s; wall {now['paper wall']:.1f} s vs "
+              f"{before['paper wall']:.1f} s]  target <= 30 s: {'met' if now['paper cpu'] <= 30.0 else 'NOT met'}")
     print(f"   import to the first result now: {ms(now['import process'])} the process's wall time (in the interpreter "
           f"{ms(now['import'])}), target <= 150 ms: {'met' if now['import process'] <= 0.150 else 'NOT met'} "
           f"(judged on the process: a CLI call or a sweep worker pays the interpreter's start too)")
 
 
-def run_section(quick: bool = False, repeats: int | None = None, before: bool = True, progress=None) -> None:
+def run_section(quick: bool = False, repeats: int | None = None, before: bool = True, progress=None,
+                paper: bool = False) -> None:
     """Measure and print the whole section (both parts)."""
     import bench_before
 
@@ -275,6 +285,10 @@ def run_section(quick: bool = False, repeats: int | None = None, before: bool = 
                 history = bench_before.measure({"before": tree, "now": ROOT}, rounds=5 if quick else 9, points=points,
                                                import_rounds=5 if quick else 9, progress=progress)
                 history.update(commit=bench_before.BASELINE_COMMIT, points=len(points))
+                if paper:  # one serial run each, alternating (minutes)
+                    for name, tree_of in (("before", tree), ("now", ROOT)):
+                        progress(f"before/now: recoil paper --workers 1, {name}")
+                        history[name]["paper cpu"], history[name]["paper wall"] = bench_before.paper_cpu(tree_of)
     print(f"\n9. issue #24: a plain scipy script at equal accuracy per metric, and now / before the issue "
           f"(load {start_load} at the start, {load()} at the end; {time.perf_counter() - start:.0f} s)")
     print_equal_accuracy(accuracy)
@@ -288,9 +302,11 @@ def main(argv=None) -> int:
     parser.add_argument("--quick", action="store_true", help="half-decade scan, fewer rounds and points")
     parser.add_argument("--repeats", type=int, help="interleaved timing rounds of the scipy comparison (7; quick 3)")
     parser.add_argument("--skip-before", action="store_true", help="skip the ratios against the code before #24")
+    parser.add_argument("--paper", action="store_true",
+                        help="also the CPU time of a serial `recoil paper --workers 1` before and now (minutes)")
     args = parser.parse_args(argv)
     warnings.simplefilter("ignore")
-    run_section(args.quick, args.repeats, not args.skip_before)
+    run_section(args.quick, args.repeats, not args.skip_before, paper=args.paper)
     return 0
 
 

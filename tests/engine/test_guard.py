@@ -173,3 +173,17 @@ def test_every_hard_and_paper_case_ends_as_without_the_collapse_window(monkeypat
             differ.append((name, now, before))
     assert not differ
     assert collapsed >= 5  # the compression_only reading's model (ii) cases at least (the window is exercised)
+
+
+def test_the_compression_only_reading_is_stopped_by_the_collapse_window():
+    """The paper's ``compression_only`` reading on model (ii) (a contact that switches off at every step while the
+    springs push the bodies together: the step collapses to 1e-10 to 8e-9 s, measured) fails after 2000 steps of the
+    first solve and 2000 of the re-solve with absolute error control, each well inside the stall window's 20 000."""
+    from mbs_models import Conventions, model_ii, simulate
+    from mbs_models.engine.guard import COLLAPSE_WINDOW_STEPS, COLLAPSE_WINDOW_TIME
+    from mbs_models.errors import SimulationError
+
+    scene = model_ii(1000.0, 0.0, Conventions(compression_only=True))
+    with pytest.raises(SimulationError, match=f"the step size collapsed: {COLLAPSE_WINDOW_STEPS} steps advanced "
+                                              f"less than {COLLAPSE_WINDOW_TIME:g} s"):
+        simulate(scene, 10.0, "standard", stop_when_final=("max_barrel_displacement",))
