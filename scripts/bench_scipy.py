@@ -2,7 +2,7 @@
 """Issue #24's benchmark section: the product against a plain scipy script at equal accuracy per metric, and against
 the code before the issue, each as ratios measured in one run.
 
-    python scripts/bench_scipy.py            # about 40 s on the 2-core machine
+    python scripts/bench_scipy.py            # about a minute on the 2-core machine
     python scripts/bench_scipy.py --quick    # about 15 s
     python scripts/bench.py ...              # section 9 is this section
 
@@ -23,10 +23,13 @@ the code before the issue, each as ratios measured in one run.
    default maximum step (none), and a maximum step of 10 ms (an engineer's guard against stepping over a contact,
    the ``draft`` preset's and the work-precision study's); both find the truth's impacts on this case.
 3. **Against the code before issue #24** (:mod:`bench_before`): a complete ``standard`` run, an early-stopped sweep
-   point (CPU per point, serial), import to the first result in a fresh interpreter; now / before.
+   point (CPU per point, serial), the fixed cost of a call (a 1 ms run), the engine's runs of the paper's
+   ``compression_only`` reading (the step guard's windows), import to the first result in a fresh interpreter, and
+   with ``--paper`` the CPU of a serial ``recoil paper --workers 1``; now / before.
 
 The issue's targets: the scipy script / ``standard`` >= 8x, / ``draft`` >= 4x; import to the first result <= 150 ms;
-a complete ``standard`` run >= 1.6x faster than before and a sweep point >= 1.5x faster.  The machine is shared:
+a complete ``standard`` run >= 1.6x faster than before and a sweep point >= 1.5x faster; a serial ``recoil paper``
+<= 30 CPU-s.  The machine is shared:
 the load (``/proc/loadavg``) is printed at the start and the end.
 """
 
@@ -283,7 +286,8 @@ def run_section(quick: bool = False, repeats: int | None = None, before: bool = 
             else:
                 points = bench_before.QUICK_SWEEP_POINTS if quick else bench_before.SWEEP_POINTS
                 history = bench_before.measure({"before": tree, "now": ROOT}, rounds=5 if quick else 9, points=points,
-                                               import_rounds=5 if quick else 9, progress=progress)
+                                               import_rounds=5 if quick else 9, progress=progress,
+                                               reading_rounds=1 if quick else 3)
                 history.update(commit=bench_before.BASELINE_COMMIT, points=len(points))
                 if paper:  # one serial run each, alternating (minutes)
                     for name, tree_of in (("before", tree), ("now", ROOT)):

@@ -115,7 +115,8 @@ def _absolute_tolerance_settings(settings: SolverSettings) -> SolverSettings | N
                    absolute_tolerance=settings.absolute_tolerance + settings.relative_tolerance)
 
 
-def _pre_step_function(assembly: Assembly, budget: StepBudget | None, tracker: FinalityTracker | None):
+def _pre_step_function(assembly: Assembly, budget: StepBudget | None, tracker: FinalityTracker | None,
+                       specialise: bool = True):
     """Exudyn pre-step function: the step budget (raises when spent), the contacts' onset capture and
     the finality tracker.
 
@@ -135,6 +136,7 @@ def _pre_step_function(assembly: Assembly, budget: StepBudget | None, tracker: F
     bodies in body order (else reordered).  With the budget alone (most adaptive solves) the function only
     counts: one Python call, an increment and a comparison per step (~0.2 us; README, "Limits"); with the budget and
     the tracker alone (a sweep's early stop) it counts and observes every :data:`OBSERVE_EVERY`-th step.
+    ``specialise=False``: the general function in every case (the same calls of the budget and the tracker).
     """
     data = assembly.mbs.systemData
     read_positions, read_velocities = data.GetODE2Coordinates, data.GetODE2Coordinates_t
@@ -207,7 +209,7 @@ def _pre_step_function(assembly: Assembly, budget: StepBudget | None, tracker: F
             return True
         return not observe(t, read_positions(copy=False).tolist(), read_velocities(copy=False).tolist())
 
-    if budget is not None and not captures and planar is None:
+    if specialise and budget is not None and not captures and planar is None:
         if observe is None:
             function = count
         elif in_body_order:
