@@ -35,10 +35,11 @@ What it measures (not a timed test: the numbers depend on the machine; the ratio
 7. **The whole-paper job**: wall time of a full ``recoil paper`` before issue #11 and now (``--paper``).
 8. **The planar model** (issue #22, :mod:`bench_carriage`): each shipped carriage scene against the same hardware
    without ``[carriage]``, per simulated second, and Exudyn's floor (a bare tree against a bare 1-D mass, per step).
-9. **Issue #24** (:mod:`bench_scipy`, about 40 s; ``--issue24-quick`` about 15 s): a plain scipy
+9. **Issue #24** (:mod:`bench_scipy`, about a minute; ``--issue24-quick`` about 20 s): a plain scipy
    script of model (ii) written from the equations (``scripts/plain_scipy.py``) at equal accuracy on *each*
    metric separately against ``standard`` and ``draft`` (section 1 matches the worst of the three), and a complete
-   run, an early-stopped sweep point and import to the first result now / before issue #24.
+   run, an early-stopped sweep point, the fixed cost of a call, the paper's ``compression_only`` reading and import
+   to the first result now / before issue #24 (the serial ``recoil paper``'s CPU: ``bench_scipy.py --paper``).
 
 It ends with issue #11's targets, each ratio beside its target.  Absolute times are printed only in
 brackets beside the ratios, for context.

@@ -16,7 +16,6 @@ A table built in Python is checked exactly like one read from TOML; every error 
 
 from __future__ import annotations
 
-import difflib
 import math
 import sys
 from dataclasses import dataclass, fields
@@ -119,6 +118,8 @@ def check_choice(key: str, value, allowed: Iterable[str], what: str = "value") -
 def suggestion(word: str, allowed: Iterable[str]) -> str:
     """``"; did you mean 'x'?"`` for the closest allowed word, else ``"; allowed: a, b, c"``."""
     allowed = sorted(allowed)
+    import difflib  # (here: a misspelt key is rare, the import is not free)
+
     close = difflib.get_close_matches(word, allowed, n=1, cutoff=0.6)
     if close:
         return f"; did you mean {close[0]!r}?"
