@@ -71,3 +71,25 @@ NUMBERS.update({
     "paper_claims_count": {"compute": _claims, "format": "{:.0f}", "rel_tol": 0.0,
                            "why": "the number of the paper's qualitative claims the report checks"},
 })
+
+
+def _light_undamped(key: str):
+    def compute() -> float:
+        from validation.studies.guarantee import LIGHT_UNDAMPED_BOUNDS, LIGHT_UNDAMPED_MASS
+
+        return LIGHT_UNDAMPED_MASS if key == "mass" else LIGHT_UNDAMPED_BOUNDS["standard"][key]
+    return compute
+
+
+NUMBERS.update({
+    "light_undamped_mass": {"compute": _light_undamped("mass"), "format": "{:g} kg", "rel_tol": 0.0,
+                            "why": "the stated exception: absorbers lighter than this, undamped"},
+    "light_undamped_force": {"compute": _light_undamped("force"), "format": "{:.0e}", "rel_tol": 0.0,
+                             "why": "the stated exception's bound on peak forces at standard"},
+    "light_undamped_peak": {"compute": _light_undamped("impact_peak"), "format": "{:.0e}", "rel_tol": 0.0,
+                            "why": "the stated exception's bound on each impact's peak at standard"},
+    "light_undamped_time": {"compute": _light_undamped("time"), "format": "{:.1g} s", "rel_tol": 0.0,
+                            "why": "the stated exception's bound on impact times at standard"},
+    "light_undamped_metric": {"compute": _light_undamped("metric"), "format": "{:.0e}", "rel_tol": 0.0,
+                              "why": "the stated exception's bound on displacements and velocities at standard"},
+})
