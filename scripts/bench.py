@@ -591,26 +591,29 @@ def main(argv=None) -> int:
         print(f"   {name:55s} {value:7.2f}   target {target:8s} {'met' if met else 'NOT met'}")
     record["targets"] = [{"name": name, "value": value, "target": target, "met": bool(met)}
                          for name, value, target, met in rows]
-    if args.json is not None:
-        import json
-        args.json.parent.mkdir(parents=True, exist_ok=True)
-        args.json.write_text(json.dumps(record, indent=1, sort_keys=False) + "\n")
-        say(f"wrote {args.json}")
     if not args.skip_carriage:
         import bench_carriage
 
         say("the carriage scenes against their 1-D twins")
         print("\n8. the planar model (issue #22): ", end="")
-        bench_carriage.print_costs(bench_carriage.carriage_costs(end_time=end_time, repeats=max(3, args.repeats // 3)),
-                                   end_time)
+        costs = bench_carriage.carriage_costs(end_time=end_time, repeats=max(3, args.repeats // 3))
+        bench_carriage.print_costs(costs, end_time)
         tree, mass = bench_carriage.bare_floor()
         print(f"   Exudyn's floor per fixed DOPRI5 step: a bare tree of the planar links {tree / mass:5.1f}x a bare "
               f"1-D mass [{tree:.1f} / {mass:.1f} us] (scripts/bench_carriage.py: the floor per simulated second)")
+        record["carriage"] = {"rows": [{key: row[key] for key in ("scene", "preset", "run_ratio", "solve_ratio",
+                                                                  "step_ratio")} for row in costs],
+                              "bare_tree_us": tree, "bare_mass_us": mass}
     if not args.skip_issue24:
         import bench_scipy
 
         sys.stdout.flush()
-        bench_scipy.run_section(quick=args.issue24_quick, progress=say)
+        record["issue24"] = bench_scipy.run_section(quick=args.issue24_quick, progress=say)
+    if args.json is not None:
+        import json
+        args.json.parent.mkdir(parents=True, exist_ok=True)
+        args.json.write_text(json.dumps(record, indent=1, sort_keys=False) + "\n")
+        say(f"wrote {args.json}")
     return 0
 
 

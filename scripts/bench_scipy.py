@@ -271,8 +271,9 @@ def print_before(out: dict) -> None:
 
 
 def run_section(quick: bool = False, repeats: int | None = None, before: bool = True, progress=None,
-                paper: bool = False) -> None:
-    """Measure and print the whole section (both parts)."""
+                paper: bool = False) -> dict:
+    """Measure and print the whole section (both parts); return its summary for ``bench.py --json``
+    (:func:`summary`)."""
     import bench_before
 
     progress = progress or (lambda message: print(f"[bench-24] {message}", file=sys.stderr, flush=True))
@@ -299,6 +300,26 @@ def run_section(quick: bool = False, repeats: int | None = None, before: bool = 
     if history is not None:
         print(f"   against the code before issue #24 (commit {history['commit'][:12]}), interleaved, medians:")
         print_before(history)
+    return summary(accuracy, history, start_load)
+
+
+def summary(accuracy: dict, history: dict | None, start_load) -> dict:
+    """The section's numbers as JSON-ready data: per variant, preset and metric the fastest plain scipy script at
+    equal accuracy (method, rtol, scipy / product wall-time ratio, the issue's target), and now / before ratios."""
+    rows = [{"variant": row["variant"], "preset": row["preset"], "metric": LABELS[row["metric"]],
+             "target_error": row["target"], "method": row.get("method"), "rtol": row.get("rtol"),
+             "ratio": row.get("ratio"), "issue_target": PRESETS[row["preset"]]} for row in accuracy["rows"]]
+    out = {"load_at_start": start_load, "scipy": rows}
+    if history is not None:
+        names = {"run wall": "complete standard run (wall)", "run cpu": "complete standard run (CPU)",
+                 "point cpu": "early-stopped sweep point (CPU per point)", "call cpu": "fixed cost of a call (CPU)",
+                 "reading cpu": "the compression_only reading's engine runs (CPU)",
+                 "import process": "import to the first result (process wall)"}
+        out["commit"] = history["commit"]
+        out["now_before"] = {label: history["now"][key] / history["before"][key] for key, label in names.items()
+                             if key in history["now"] and key in history["before"]}
+        out["import_process_s"] = history["now"].get("import process")
+    return out
 
 
 def main(argv=None) -> int:

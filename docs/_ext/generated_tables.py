@@ -73,6 +73,34 @@ def bench_tables(data: dict) -> str:
         parts += ["### Issue #11's targets\n", "| ratio | measured | target | |", "|---|---:|---|---|",
                   *[f"| {row['name']} | {row['value']:.2f} | {row['target']} | {'met' if row['met'] else 'not met'} |"
                     for row in data["targets"]], ""]
+    if "carriage" in data:
+        floor = data["carriage"]
+        parts += ["### The gun on its carriage\n",
+                  "A carriage scene against its 1-D twin (the same hardware on a fixed mount), per simulated second. "
+                  f"Exudyn's own floor: a bare tree of the planar links costs "
+                  f"{floor['bare_tree_us'] / floor['bare_mass_us']:.1f}x a bare 1-D mass per fixed DOPRI5 step "
+                  f"({floor['bare_tree_us']:.1f} against {floor['bare_mass_us']:.1f} us).\n",
+                  "| scene | preset | complete run | solve | steps |", "|---|---|---:|---:|---:|",
+                  *[f"| `{row['scene']}` | `{row['preset']}` | {row['run_ratio']:.1f}x | {row['solve_ratio']:.1f}x | "
+                    f"{row['step_ratio']:.2f}x |" for row in floor["rows"]], ""]
+    if "issue24" in data:
+        section = data["issue24"]
+        parts += ["### A plain scipy script at equal accuracy, per metric\n",
+                  "The fastest of scipy's `solve_ivp` methods (`scripts/plain_scipy.py`, written from the equations "
+                  "with numpy and scipy only) at the loosest tolerance that is as accurate as the preset on each "
+                  "metric separately; the ratio is the script's wall time over the product's complete run.\n",
+                  "| script | preset | metric | preset's error | fastest script | scipy / product | issue's target |",
+                  "|---|---|---|---:|---|---:|---:|",
+                  *[f"| {row['variant']} | `{row['preset']}` | {row['metric']} | {row['target_error']:.1e} | "
+                    + (f"{row['method']} rtol {row['rtol']:.2g} | {row['ratio']:.2f}x" if row["ratio"] is not None
+                       else "none reached it | -")
+                    + f" | >= {row['issue_target']:g}x |" for row in section["scipy"]], ""]
+        if "now_before" in section:
+            parts += ["### Now against the code before the speed work\n",
+                      f"Ratios now / before (commit `{section['commit'][:12]}`), both trees measured in the same run, "
+                      "interleaved (below 1: faster now).\n",
+                      "| measurement | now / before |", "|---|---:|",
+                      *[f"| {name} | {value:.3f} |" for name, value in section["now_before"].items()], ""]
     return "\n".join(parts)
 
 
