@@ -33,7 +33,6 @@ extensions = [
     "sphinx.ext.mathjax",
     "sphinx-mathjax-offline",
     "sphinx_gallery.gen_gallery",
-    "placeholders",
     "attribute_sections",
     "key_reference",
     "generated_tables",
