@@ -12,12 +12,10 @@ problem is one :class:`~mbs_models.errors.SceneError` naming the key the caller 
 
 from __future__ import annotations
 
-import csv
 import io
 import os
 import re
 import stat
-import tomllib
 from pathlib import Path
 from typing import Callable
 
@@ -80,6 +78,8 @@ def read_two_columns(path: str | Path, key: str, what: str, columns: str, max_ro
     """The number pairs of a CSV file of two columns (``columns``, e.g. ``"time,force"``) after one header line: a
     file within the input limits (:func:`read_text_file`, ``what`` names it), at most ``max_rows`` pairs
     (``too_many()`` is the error past them).  Every error is a SceneError naming ``key``."""
+    import csv  # (imported here: a run reads no CSV file)
+
     text = read_text_file(path, key, what)
     rows = []
     try:
@@ -142,6 +142,8 @@ def check_toml_nesting(text: str, key: str, where: str) -> None:
 def parse_toml(text: str, key: str, where: str) -> dict:
     """``tomllib.loads(text)`` with its nesting bounded by :data:`MAX_TOML_NESTING`; SceneError naming ``key``
     for malformed or too deeply nested TOML (``where`` names the text in the message: a file's path)."""
+    import tomllib  # (imported here: a run of a scene built in Python parses no TOML)
+
     check_toml_nesting(text, key, where)
     try:
         data = tomllib.loads(text)

@@ -1,5 +1,11 @@
 """Writing output files safely: check the directory first, write to a temporary name, then rename.
 
+One rule for every output directory of every ``recoil`` command: a missing directory is created (with its
+parents), but only once the input has been checked, so that bad input leaves nothing behind.  A command checks
+its outputs first, creating nothing (:func:`check_output_dir`, :func:`check_output_file`: an existing path must
+be a writable directory, a missing one must have a writable directory as its nearest existing ancestor), and
+creates them when it writes (:func:`prepare_output_dir`, :func:`prepare_output_file`).
+
 A report that fails half-way never leaves a half-written file under its final name.  The files get the
 permissions any tool gives a new file: ``0666`` minus the process's umask (``0644`` under umask 022),
 not the ``0600`` of a temporary file.
@@ -65,19 +71,20 @@ def current_umask() -> int:
 
 
 def check_output_file(path: str | Path, key: str) -> Path:
-    """Check that a file can be written at ``path``: its directory exists and is writable, and ``path``
-    is not a directory.  SceneError naming ``key`` otherwise; nothing is created (a missing directory is
-    refused, not made: a typo must not leave a directory tree behind)."""
+    """Check, creating nothing, that a file can be written at ``path``: ``path`` is not a directory and its
+    directory exists and is writable, or can be created (:func:`check_output_dir`).  SceneError naming ``key``
+    otherwise.  :func:`prepare_output_file` creates the directory once the input is known to be good."""
     path = Path(path)
-    directory = path.parent
     if path.is_dir():
         raise SceneError(key, f"{path} is a directory, not a file")
-    if not directory.exists():
-        raise SceneError(key, f"directory {directory} does not exist")
-    if not directory.is_dir():
-        raise SceneError(key, f"{directory} is not a directory")
-    if not os.access(directory, os.W_OK | os.X_OK):
-        raise SceneError(key, f"directory {directory} is not writable")
+    check_output_dir(path.parent if str(path.parent) else Path("."), key)
+    return path
+
+
+def prepare_output_file(path: str | Path, key: str) -> Path:
+    """:func:`check_output_file`, then create the file's missing directories (:func:`prepare_output_dir`)."""
+    path = check_output_file(path, key)
+    prepare_output_dir(path.parent if str(path.parent) else Path("."), key)
     return path
 
 

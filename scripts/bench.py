@@ -35,10 +35,11 @@ What it measures (not a timed test: the numbers depend on the machine; the ratio
 7. **The whole-paper job**: wall time of a full ``recoil paper`` before issue #11 and now (``--paper``).
 8. **The planar model** (issue #22, :mod:`bench_carriage`): each shipped carriage scene against the same hardware
    without ``[carriage]``, per simulated second, and Exudyn's floor (a bare tree against a bare 1-D mass, per step).
-9. **Issue #24** (:mod:`bench_scipy`, about 40 s; ``--issue24-quick`` about 15 s): a plain scipy
+9. **Issue #24** (:mod:`bench_scipy`, about a minute; ``--issue24-quick`` about 20 s): a plain scipy
    script of model (ii) written from the equations (``scripts/plain_scipy.py``) at equal accuracy on *each*
    metric separately against ``standard`` and ``draft`` (section 1 matches the worst of the three), and a complete
-   run, an early-stopped sweep point and import to the first result now / before issue #24.
+   run, an early-stopped sweep point, the fixed cost of a call, the paper's ``compression_only`` reading and import
+   to the first result now / before issue #24 (the serial ``recoil paper``'s CPU: ``bench_scipy.py --paper``).
 
 It ends with issue #11's targets, each ratio beside its target.  Absolute times are printed only in
 brackets beside the ratios, for context.
@@ -285,6 +286,9 @@ def main(argv=None) -> int:
                         help="gaps of the Figs 4/5 sweep per model and mass (default 121: 726 points)")
     parser.add_argument("--sweep-rounds", type=int, default=3,
                         help="alternating rounds of the sweep variants, the fastest of each taken (default 3)")
+    parser.add_argument("--json", metavar="PATH", type=Path,
+                        help="also write the measured ratios, the machine load and the date to PATH (JSON; the docs' "
+                             "performance page renders docs/_generated/bench.json)")
     parser.add_argument("--paper", action="store_true",
                         help="also time a full `recoil paper` before issue #11 and now (about a minute)")
     args = parser.parse_args(argv)
@@ -456,6 +460,12 @@ def main(argv=None) -> int:
         return ", ".join(f"{m.replace('max_', '').replace('_', ' ')} {errors[m]:.1e}" for m in metrics)
 
     load = t["standard"] / t["standard cpu"]
+    record = {"date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), "scene": scene.name, "end_time_s": end_time,
+              "repeats": args.repeats, "machine_load": load, "load_average_1min": os.getloadavg()[0], "cpus": os.cpu_count(),
+              "command": "python scripts/bench.py " + " ".join(argv if argv is not None else sys.argv[1:]),
+              "standard": {"steps": result.steps, "errors": dict(standard_errors),
+                           "solve_fraction": t_standard_solve / t_standard}, "ratios": {}}
+    ratios = record["ratios"]
     print()
     print(f"standard preset: errors {err_text(standard_errors)}; {result.steps} steps; the solve is "
           f"{100 * t_standard_solve / t_standard:.0f} % of a complete run [context: {ms(t_standard)}]")
@@ -472,6 +482,8 @@ def main(argv=None) -> int:
         print("   LSODA reached the standard preset's accuracy at no tolerance down to 1e-13: no ratio")
     else:
         rtol, lsoda_errors, t_lsoda, t_lsoda_solve = lsoda
+        ratios["LSODA / standard, complete run (equal accuracy)"] = t_lsoda / t_standard
+        ratios["LSODA / standard, integration alone"] = t_lsoda_solve / t_standard_solve
         print(f"   LSODA rtol {rtol:.3g} (atol rtol x 1e-2): errors {err_text(lsoda_errors)}")
         print(f"   LSODA / standard, complete run (solve + metrics):   {t_lsoda / t_standard:6.2f}x "
               f"(CPU time {t['lsoda cpu'] / t['standard cpu']:.2f}x) [{ms(t_lsoda)} vs {ms(t_standard)}]")
@@ -482,6 +494,10 @@ def main(argv=None) -> int:
         print(f"   {compiled_note}")
     else:
         t_c, steps, c_errors, t_c_post, compiler, rejected = compiled
+        ratios["standard solve / compiled DOPRI5 integration"] = t_standard_solve / t_c
+        ratios["standard complete run / compiled DOPRI5 integration"] = t_standard / t_c
+        ratios["standard complete run / (compiled + the same post-processing)"] = t_standard / (t_c + t_c_post)
+        ratios["Exudyn's floor / compiled DOPRI5 integration"] = t["exudyn floor per step"] * result.steps / t_c
         print(f"   compiled with {compiler} -O2: {steps} steps ({rejected} rejected; Exudyn: {result.steps}), "
               f"errors {err_text(c_errors)}")
         print(f"   standard solve / compiled integration:            {t_standard_solve / t_c:6.1f}x "
@@ -502,6 +518,8 @@ def main(argv=None) -> int:
     for name, value in stages.items():
         print(f"   {name:40s} {100 * value / run_total:5.1f} %  [{ms(value)}]")
     print(f"   (stage sum / simulate() wall time: {run_total / t_standard:.2f})")
+    record["breakdown"] = {"import / one run": import_total / run_total,
+                           **{name.strip(): value / run_total for name, value in stages.items()}}
     print(f"   post-processing (analyse) / solve: {stages['metrics (analyse)'] / stages['solve (Exudyn SolveDynamic)']:.3f}"
           " (issue #11's target: <= 0.15)")
     if memory is not None:
@@ -522,6 +540,11 @@ def main(argv=None) -> int:
             print(f"   {n} absorber{'s' if n > 1 else ' '}: complete run {run / base_run:5.2f}x, solve {solve / base_solve:5.2f}x, "
                   f"solve per step {solve / steps / (base_solve / base_steps):5.2f}x  [{ms(run)}, {steps} steps]")
         (law_run, law_solve, law_steps), (hc_run, hc_solve, hc_steps) = law_costs.values()
+        record["elements"] = {f"{n} absorbers": {"complete run": run / base_run, "solve": solve / base_solve,
+                                                 "solve per step": solve / steps / (base_solve / base_steps)}
+                              for n, (run, solve, steps) in absorber_costs.items()}
+        record["elements"]["onset capture (exact-restitution / Hunt-Crossley)"] = {
+            "complete run": law_run / hc_run, "solve per step": law_solve / law_steps / (hc_solve / hc_steps)}
         print(f"   onset capture (exact-restitution / Hunt-Crossley at the same first impact): solve per step "
               f"{law_solve / law_steps / (hc_solve / hc_steps):5.2f}x, complete run {law_run / hc_run:5.2f}x "
               f"[{law_steps} vs {hc_steps} steps]")
@@ -571,21 +594,31 @@ def main(argv=None) -> int:
     print("\nissue #11's targets (ratios of this run; the machine's load affects the wall-time ones)")
     for name, value, target, met in rows:
         print(f"   {name:55s} {value:7.2f}   target {target:8s} {'met' if met else 'NOT met'}")
+    record["targets"] = [{"name": name, "value": value, "target": target, "met": bool(met)}
+                         for name, value, target, met in rows]
     if not args.skip_carriage:
         import bench_carriage
 
         say("the carriage scenes against their 1-D twins")
         print("\n8. the planar model (issue #22): ", end="")
-        bench_carriage.print_costs(bench_carriage.carriage_costs(end_time=end_time, repeats=max(3, args.repeats // 3)),
-                                   end_time)
+        costs = bench_carriage.carriage_costs(end_time=end_time, repeats=max(3, args.repeats // 3))
+        bench_carriage.print_costs(costs, end_time)
         tree, mass = bench_carriage.bare_floor()
         print(f"   Exudyn's floor per fixed DOPRI5 step: a bare tree of the planar links {tree / mass:5.1f}x a bare "
               f"1-D mass [{tree:.1f} / {mass:.1f} us] (scripts/bench_carriage.py: the floor per simulated second)")
+        record["carriage"] = {"rows": [{key: row[key] for key in ("scene", "preset", "run_ratio", "solve_ratio",
+                                                                  "step_ratio")} for row in costs],
+                              "bare_tree_us": tree, "bare_mass_us": mass}
     if not args.skip_issue24:
         import bench_scipy
 
         sys.stdout.flush()
-        bench_scipy.run_section(quick=args.issue24_quick, progress=say)
+        record["issue24"] = bench_scipy.run_section(quick=args.issue24_quick, progress=say)
+    if args.json is not None:
+        import json
+        args.json.parent.mkdir(parents=True, exist_ok=True)
+        args.json.write_text(json.dumps(record, indent=1, sort_keys=False) + "\n")
+        say(f"wrote {args.json}")
     return 0
 
 

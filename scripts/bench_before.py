@@ -10,6 +10,10 @@ that a shared machine's load drifts into both alike (and in alternating order):
 * a complete ``standard`` run of model (ii) (m = 1000 kg, gap 0), 10 s: median wall and CPU time;
 * an early-stopped point of the Figs 4/5 grid (``stop_when_final=("max_barrel_displacement",)``), serial: CPU time
   (``time.process_time``) per point, the median over rounds of each round's mean over the points;
+* the fixed cost of a call: CPU per ``simulate`` of a 1 ms window (model (ii), ``standard``), a mean over
+  :data:`FIXED_COST_CALLS` calls;
+* the engine's runs of the ``compression_only`` reading of the convention study (``recoil paper``), whose cases
+  fail on a collapsed step: CPU of the reading (the step guard's stall and collapse windows);
 * import to the first result in a fresh interpreter (``import mbs_models`` and ``simulate(model_ii(), 0.01)``):
   the interpreter's own clock from before the import to the result, the process's wall time and its CPU time
   (user + system, less sensitive to a shared machine's load); medians.
@@ -55,6 +59,19 @@ for line in sys.stdin:
         result = simulate(scene, 10.0, "standard")
         answer = {"wall": time.perf_counter() - wall, "cpu": time.process_time() - cpu,
                   "values": [result.max_barrel_displacement, result.steps]}
+    elif request["what"] == "call":
+        scene = model_ii(1000.0, 0.0)
+        cpu = time.process_time()
+        for _ in range(request["calls"]):
+            simulate(scene, 1e-3, "standard")
+        answer = {"cpu": (time.process_time() - cpu) / request["calls"]}
+    elif request["what"] == "reading":
+        from validation.studies.conventions import CONVENTION_CASES, convention_jobs, engine_job
+        labels = [label for label, _ in CONVENTION_CASES]
+        scenes = [scene for index, _, scene in convention_jobs() if labels[index] == request["label"]]
+        cpu = time.process_time()
+        outcomes = [engine_job(scene) for scene in scenes]
+        answer = {"cpu": time.process_time() - cpu, "failed": sum("error" in outcome for outcome in outcomes)}
     else:
         scenes = [(model_i if model == "i" else model_ii)(mass, gap) for model, mass, gap in request["points"]]
         cpu = time.process_time()
@@ -127,17 +144,38 @@ def import_once(tree: Path) -> tuple[float, float, float]:
     return float(out[0]), wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
+def paper_cpu(tree: Path) -> tuple[float, float]:
+    """(CPU s, user + system, and wall s) of a full serial ``recoil paper --workers 1`` with the code in ``tree``,
+    output into a temporary directory."""
+    with tempfile.TemporaryDirectory(prefix="recoil-paper-") as out:
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
+        start = time.perf_counter()
+        subprocess.run([sys.executable, "-m", "mbs_models", "paper", "--out", out, "--workers", "1"], cwd=str(tree),
+                       env=_environment(tree), check=True, capture_output=True)
+        wall = time.perf_counter() - start
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime), wall
+
+
 def _alternating(items: dict, round_: int) -> list:
     """The items in their order in even rounds, reversed in odd ones (neither tree always goes first)."""
     pairs = list(items.items())
     return pairs if round_ % 2 == 0 else pairs[::-1]
 
 
+#: Calls of a 1 ms run per round of the fixed-cost measurement.
+FIXED_COST_CALLS = 50
+#: The reading of the paper whose cases collapse the engine's step (the step guard's collapse window).
+COLLAPSING_READING = "compression_only"
+
+
 def measure(trees: dict[str, Path], rounds: int = 9, points=SWEEP_POINTS, import_rounds: int = 9,
-            progress=lambda message: None) -> dict:
-    """Median times per tree (``{"run wall", "run cpu", "point cpu", "import", "import process", "import process
-    cpu"}`` in s), the
-    files each imported (``"file"``) and whether the trees gave the same values (``"same values"``)."""
+            progress=lambda message: None, reading_rounds: int = 3) -> dict:
+    """Median times per tree (``{"run wall", "run cpu", "point cpu", "call cpu", "reading cpu", "import", "import
+    process", "import process cpu"}`` in s), the files each imported (``"file"``) and whether the trees gave the
+    same values (``"same values"``).  ``"call cpu"``: CPU per ``simulate`` of a 1 ms window (model (ii), standard):
+    the fixed cost of a call; ``"reading cpu"``: the engine's runs of the :data:`COLLAPSING_READING` reading of the
+    convention study (its cases fail on a collapsed step), in the first ``reading_rounds`` rounds."""
     samples: dict[str, dict[str, list[float]]] = {name: {} for name in trees}
     values: dict[str, list] = {name: [] for name in trees}
     workers = {name: Worker(tree) for name, tree in trees.items()}
@@ -150,9 +188,14 @@ def measure(trees: dict[str, Path], rounds: int = 9, points=SWEEP_POINTS, import
             for name, worker in _alternating(workers, round_):
                 run = worker.ask(what="run")
                 sweep = worker.ask(what="points", points=[list(p) for p in points])
+                call = worker.ask(what="call", calls=FIXED_COST_CALLS)
                 samples[name].setdefault("run wall", []).append(run["wall"])
                 samples[name].setdefault("run cpu", []).append(run["cpu"])
                 samples[name].setdefault("point cpu", []).append(sweep["cpu"])
+                samples[name].setdefault("call cpu", []).append(call["cpu"])
+                if round_ < reading_rounds:
+                    samples[name].setdefault("reading cpu", []).append(
+                        worker.ask(what="reading", label=COLLAPSING_READING)["cpu"])
                 if round_ == 0:
                     values[name] = [run["values"], sweep["values"]]
     finally:

@@ -2,7 +2,7 @@
 """Issue #24's benchmark section: the product against a plain scipy script at equal accuracy per metric, and against
 the code before the issue, each as ratios measured in one run.
 
-    python scripts/bench_scipy.py            # about 40 s on the 2-core machine
+    python scripts/bench_scipy.py            # about a minute on the 2-core machine
     python scripts/bench_scipy.py --quick    # about 15 s
     python scripts/bench.py ...              # section 9 is this section
 
@@ -23,10 +23,13 @@ the code before the issue, each as ratios measured in one run.
    default maximum step (none), and a maximum step of 10 ms (an engineer's guard against stepping over a contact,
    the ``draft`` preset's and the work-precision study's); both find the truth's impacts on this case.
 3. **Against the code before issue #24** (:mod:`bench_before`): a complete ``standard`` run, an early-stopped sweep
-   point (CPU per point, serial), import to the first result in a fresh interpreter; now / before.
+   point (CPU per point, serial), the fixed cost of a call (a 1 ms run), the engine's runs of the paper's
+   ``compression_only`` reading (the step guard's windows), import to the first result in a fresh interpreter, and
+   with ``--paper`` the CPU of a serial ``recoil paper --workers 1``; now / before.
 
 The issue's targets: the scipy script / ``standard`` >= 8x, / ``draft`` >= 4x; import to the first result <= 150 ms;
-a complete ``standard`` run >= 1.6x faster than before and a sweep point >= 1.5x faster.  The machine is shared:
+a complete ``standard`` run >= 1.6x faster than before and a sweep point >= 1.5x faster; a serial ``recoil paper``
+<= 30 CPU-s.  The machine is shared:
 the load (``/proc/loadavg``) is printed at the start and the end.
 """
 
@@ -252,21 +255,32 @@ def print_before(out: dict) -> None:
     rows = [("complete standard run, model (ii) 10 s (wall)", "run wall", 1 / 1.6),
             ("complete standard run (CPU)", "run cpu", 1 / 1.6),
             (f"early-stopped sweep point, CPU per point ({out['points']} points)", "point cpu", 1 / 1.5),
+            ("fixed cost of a call: a 1 ms standard run (CPU)", "call cpu", None),
+            ("the compression_only reading's engine runs, recoil paper (CPU)", "reading cpu", None),
             ("import to the first result (in the interpreter)", "import", None),
             ("import to the first result (process wall)", "import process", None),
             ("import to the first result (process CPU, user + system)", "import process cpu", None)]
     for name, key, target in rows:
+        if key not in now or key not in before:
+            continue
         ratio = now[key] / before[key]
         verdict = "" if target is None else \
             f"  target <= {target:.3f} ({1 / target:g}x faster): {'met' if ratio <= target else 'NOT met'}"
         print(f"   {name:58s} now/before {ratio:6.3f}  [{ms(now[key])} vs {ms(before[key])}]{verdict}")
+    if "paper cpu" in now:
+        ratio = now["paper cpu"] / before["paper cpu"]
+        print(f"   {'full recoil paper --workers 1 (CPU s, user + system)':58s} now/before {ratio:6.3f}  "
+              f"[{now['paper cpu']:.1f} s vs {before['paper cpu']:.1f} s; wall {now['paper wall']:.1f} s vs "
+              f"{before['paper wall']:.1f} s]  target <= 30 s: {'met' if now['paper cpu'] <= 30.0 else 'NOT met'}")
     print(f"   import to the first result now: {ms(now['import process'])} the process's wall time (in the interpreter "
           f"{ms(now['import'])}), target <= 150 ms: {'met' if now['import process'] <= 0.150 else 'NOT met'} "
           f"(judged on the process: a CLI call or a sweep worker pays the interpreter's start too)")
 
 
-def run_section(quick: bool = False, repeats: int | None = None, before: bool = True, progress=None) -> None:
-    """Measure and print the whole section (both parts)."""
+def run_section(quick: bool = False, repeats: int | None = None, before: bool = True, progress=None,
+                paper: bool = False) -> dict:
+    """Measure and print the whole section (both parts); return its summary for ``bench.py --json``
+    (:func:`summary`)."""
     import bench_before
 
     progress = progress or (lambda message: print(f"[bench-24] {message}", file=sys.stderr, flush=True))
@@ -280,14 +294,39 @@ def run_section(quick: bool = False, repeats: int | None = None, before: bool = 
             else:
                 points = bench_before.QUICK_SWEEP_POINTS if quick else bench_before.SWEEP_POINTS
                 history = bench_before.measure({"before": tree, "now": ROOT}, rounds=5 if quick else 9, points=points,
-                                               import_rounds=5 if quick else 9, progress=progress)
+                                               import_rounds=5 if quick else 9, progress=progress,
+                                               reading_rounds=1 if quick else 3)
                 history.update(commit=bench_before.BASELINE_COMMIT, points=len(points))
+                if paper:  # one serial run each, alternating (minutes)
+                    for name, tree_of in (("before", tree), ("now", ROOT)):
+                        progress(f"before/now: recoil paper --workers 1, {name}")
+                        history[name]["paper cpu"], history[name]["paper wall"] = bench_before.paper_cpu(tree_of)
     print(f"\n9. issue #24: a plain scipy script at equal accuracy per metric, and now / before the issue "
           f"(load {start_load} at the start, {load()} at the end; {time.perf_counter() - start:.0f} s)")
     print_equal_accuracy(accuracy)
     if history is not None:
         print(f"   against the code before issue #24 (commit {history['commit'][:12]}), interleaved, medians:")
         print_before(history)
+    return summary(accuracy, history, start_load)
+
+
+def summary(accuracy: dict, history: dict | None, start_load) -> dict:
+    """The section's numbers as JSON-ready data: per variant, preset and metric the fastest plain scipy script at
+    equal accuracy (method, rtol, scipy / product wall-time ratio, the issue's target), and now / before ratios."""
+    rows = [{"variant": row["variant"], "preset": row["preset"], "metric": LABELS[row["metric"]],
+             "target_error": row["target"], "method": row.get("method"), "rtol": row.get("rtol"),
+             "ratio": row.get("ratio"), "issue_target": PRESETS[row["preset"]]} for row in accuracy["rows"]]
+    out = {"load_at_start": start_load, "scipy": rows}
+    if history is not None:
+        names = {"run wall": "complete standard run (wall)", "run cpu": "complete standard run (CPU)",
+                 "point cpu": "early-stopped sweep point (CPU per point)", "call cpu": "fixed cost of a call (CPU)",
+                 "reading cpu": "the compression_only reading's engine runs (CPU)",
+                 "import process": "import to the first result (process wall)"}
+        out["commit"] = history["commit"]
+        out["now_before"] = {label: history["now"][key] / history["before"][key] for key, label in names.items()
+                             if key in history["now"] and key in history["before"]}
+        out["import_process_s"] = history["now"].get("import process")
+    return out
 
 
 def main(argv=None) -> int:
@@ -295,9 +334,11 @@ def main(argv=None) -> int:
     parser.add_argument("--quick", action="store_true", help="half-decade scan, fewer rounds and points")
     parser.add_argument("--repeats", type=int, help="interleaved timing rounds of the scipy comparison (7; quick 3)")
     parser.add_argument("--skip-before", action="store_true", help="skip the ratios against the code before #24")
+    parser.add_argument("--paper", action="store_true",
+                        help="also the CPU time of a serial `recoil paper --workers 1` before and now (minutes)")
     args = parser.parse_args(argv)
     warnings.simplefilter("ignore")
-    run_section(args.quick, args.repeats, not args.skip_before)
+    run_section(args.quick, args.repeats, not args.skip_before, paper=args.paper)
     return 0
 
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env python
-"""The worst errors over the hard cases, per accuracy preset: the "worst" numbers of the README's guarantee table.
+"""The worst errors over the hard cases, per accuracy preset: the "worst" numbers of the guarantee table.
 
     python scripts/guarantee_table.py          # all hard cases, three presets (a few minutes)
 

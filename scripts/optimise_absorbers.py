@@ -1,5 +1,6 @@
 #!/usr/bin/env python
-"""The README's design optimisation of the paper's absorbers: ``python scripts/optimise_absorbers.py``.
+"""The user guide's design optimisation of the paper's absorbers (docs/guide/optimise.md):
+``python scripts/optimise_absorbers.py``.
 
 For each mount -- model (i) (absorber on the barrel) and model (ii) (absorber on the ground) -- the
 absorber mass (100-2000 kg) and gap (0-120 mm) that
@@ -15,7 +16,7 @@ alone, tol 1e-4), accuracy
 ``standard``, every point stopped once its metrics are proven final.  Each optimum is then re-simulated
 over the full 10 s (``standard`` and ``reference``) to confirm its numbers, and the early stop's saving is
 measured on a sample of the evaluated points.  Writes ``docs/figures/optimise_absorbers.png`` and
-``docs/optimise_absorbers.json``; prints the README's tables.  About 1-2 minutes on 2 cores.
+``docs/optimise_absorbers.json``; prints the guide's tables.  About 1-2 minutes on 2 cores.
 """
 
 from __future__ import annotations
@@ -139,7 +140,7 @@ def main() -> int:
 
 
 def print_tables(data) -> None:
-    """The README's table: every design's recoil length and force on the mount (full 10 s runs)."""
+    """The guide's table: every design's recoil length and force on the mount (full 10 s runs)."""
     simplified = data["simplified"]
     print("\n| mount | design | m (kg) | gap (mm) | recoil length (mm) | peak force on the mount (kN) |")
     print("|---|---|---|---|---|---|")

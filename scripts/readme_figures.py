@@ -1,5 +1,5 @@
 #!/usr/bin/env python
-"""The README's figures of richer mechanisms: ``python scripts/readme_figures.py`` writes ``docs/figures/*.png``.
+"""The documentation's figures of richer mechanisms: ``python scripts/readme_figures.py`` writes ``docs/figures/*.png``.
 
 One figure per shipped version-2 example scene that is not a contact-law variant (``NAME.png``):
 positions, contact forces, the force on the mount and velocities over the first 3 s, and a zoom on the first impact.

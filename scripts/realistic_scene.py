@@ -1,6 +1,6 @@
 #!/usr/bin/env python
 """The "realistic" example: ``python scripts/realistic_scene.py`` writes ``mbs_models/scenes/realistic.toml``
-and its README figures ``docs/figures/realistic_*.png``, and prints the per-shot table.
+and its figures ``docs/figures/realistic_*.png``, and prints the per-shot table.
 
 The scene combines what a designer sizes: a breech-force pulse with the gas after-effect (7369 N s), a
 recuperator whose 36 kN preload holds the 5.6 t barrel in battery at 30 degrees of elevation against
@@ -80,7 +80,7 @@ def main() -> int:
     print(f"wrote {path}")
     result = figures(scene, comparison, ROOT / "docs" / "figures")
     from mbs_models import simplified_model
-    simple = compare_with_linear_damper(simplified_model(), 0.2215)  # the README's design-brake example
+    simple = compare_with_linear_damper(simplified_model(), 0.2215)  # the user guide's design-brake example
     save_figure(plot_comparison(simple), ROOT / "docs" / "figures" / "design_brake.png")
     d = comparison.to_dict()
     print(f"constant resistance {d['constant_resistance'] / 1e3:.2f} kN, flat to "

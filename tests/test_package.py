@@ -26,6 +26,17 @@ def test_scene_api_does_not_load_exudyn():
     assert proc.returncode == 0, proc.stderr
 
 
+def test_a_run_imports_no_plotting_table_or_cluster_library():
+    """``import mbs_models`` and a first ``simulate`` (what every CLI call and sweep worker pays) load none of
+    matplotlib, pandas, dask, scipy, tqdm and pyarrow: each is imported where it is used."""
+    heavy = ("matplotlib", "pandas", "dask", "scipy", "tqdm", "pyarrow")
+    proc = _run("import sys, mbs_models; after_import = sorted(m for m in sys.modules if m.split('.')[0] in %r); "
+                "mbs_models.simulate(mbs_models.model_ii(), 0.01); "
+                "after_run = sorted(m for m in sys.modules if m.split('.')[0] in %r); "
+                "assert not after_import and not after_run, (after_import, after_run)" % (heavy, heavy))
+    assert proc.returncode == 0, proc.stderr
+
+
 def test_public_names_resolve():
     import mbs_models
 

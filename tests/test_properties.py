@@ -23,8 +23,8 @@ from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from mbs_models import Scene, model_i, model_ii, simulate
-from validation.studies.guarantee import (TOLERANCES, errors_against_reference, physical_violations, reference_for,
-                                           violations)
+from validation.studies.guarantee import (LIGHT_UNDAMPED_BOUNDS, TOLERANCES, errors_against_reference,
+                                           light_undamped_absorber, physical_violations, reference_for, violations)
 
 # random gaps may lie beyond the free-recoil travel (the warning is tested elsewhere)
 pytestmark = pytest.mark.filterwarnings("ignore:absorber.*beyond the barrel's free-recoil travel:mbs_models.errors.UnitWarning")
@@ -111,8 +111,35 @@ CHATTERING = model_ii(1.0, 0.0).with_changes(**{
     "contact.stiffness": 1e9, "contact.exponent": 1.5, "contact.damping_factor": 0.0, "absorber.damping": 0.0})
 
 
+#: Found by hypothesis (only when the set of imported modules changed its draws, see conftest.py): an undamped
+#: 1-kg absorber on a stiff quadratic contact chatters ~30 times in 1 s with penetrations of ~0.4 mm: at `standard`
+#: its peak contact force is off by 3.5e-5 (the guarantee for peak forces: 2e-5).  A scan of its neighbours (model
+#: (ii), 1 kg, absorber and contact undamped, recoil damper off and on, k_c 1e8 to 1e12, n_c 1 to 2, 56 to 564 m/s:
+#: 45 scenes) found worse: peak forces 4.8e-4, impact peaks 4.9e-4, impact times 3.6e-4 s (k_c 1e12, n_c 1.5, 564
+#: m/s, the paper's recoil damper), absorber velocities 5.9e-5 (the same at 56.4 m/s, no damper); ten kilograms
+#: undamped stay within the guarantee.  The stated exception (validation.studies.guarantee.LIGHT_UNDAMPED_BOUNDS;
+#: docs/validation/checks.md), pinned below on the scan's worst scenes.
+STIFF_CHATTER = CHATTERING.with_changes(**{"contact.stiffness": 1e10, "contact.exponent": 2.0})
+LIGHT_UNDAMPED_WORST = {
+    "k1e10-n2-v100": STIFF_CHATTER,
+    "k1e12-n1.5-v56": CHATTERING.with_changes(**{"contact.stiffness": 1e12, "firing.muzzle_velocity": 56.4}),
+    "k1e10-n1.5-v564": CHATTERING.with_changes(**{"contact.stiffness": 1e10, "firing.muzzle_velocity": 564.0}),
+    "damped-recoil-k1e12-n1.5-v564": model_ii(1.0, 0.0).with_changes(**{
+        "firing.muzzle_velocity": 564.0, "contact.stiffness": 1e12, "contact.exponent": 1.5,
+        "contact.damping_factor": 0.0, "absorber.damping": 0.0}),
+    "damped-recoil-k1e10-n1.5-v56": model_ii(1.0, 0.0).with_changes(**{
+        "firing.muzzle_velocity": 56.4, "contact.stiffness": 1e10, "contact.exponent": 1.5,
+        "contact.damping_factor": 0.0, "absorber.damping": 0.0}),
+}
+
+
+def _outside_the_stated_exception(scene) -> bool:
+    """The random scenes leave out the stated exception (its own tests below hold it to its stated bounds)."""
+    return not light_undamped_absorber(scene)
+
+
 @FAST
-@given(scene=scenes())
+@given(scene=scenes().filter(_outside_the_stated_exception))
 @example(scene=CHATTERING)
 @example(scene=BOUNCING_TO_REST)
 @example(scene=LIGHT_UNDAMPED)
@@ -124,7 +151,7 @@ def test_random_scenes_standard(scene):
 @pytest.mark.parametrize("accuracy", list(TOLERANCES))
 def test_random_scenes_every_preset(accuracy):
     @SLOW
-    @given(scene=scenes())
+    @given(scene=scenes().filter(_outside_the_stated_exception))
     def run(scene):
         check_scene(scene, accuracy)
 
@@ -147,22 +174,33 @@ def test_regression_scenes_every_preset(name, accuracy):
     check_scene(REGRESSIONS[name][0], accuracy)
 
 
-#: Found by hypothesis (only when the set of imported modules changed its draws, see conftest.py): an undamped
-#: 1-kg absorber on a stiff quadratic contact chatters ~30 times in 1 s with penetrations of ~0.4 mm. Its force
-#: F = k d^2 has the relative error 2 (position error) / d, and the positions' error is the preset's absolute
-#: one: at `standard` the peak contact force is off by 3.5e-5 (the guarantee for peak forces: 2e-5; the
-#: per-impact peak bound 1e-4 holds), at `draft` two impacts within a few N of the threshold count on one side
-#: only. A stated exception (README, "What is guaranteed"), pinned here so it cannot grow unnoticed.
-STIFF_CHATTER = CHATTERING.with_changes(**{"contact.stiffness": 1e10, "contact.exponent": 2.0})
 
 
-def test_light_chattering_absorber_is_the_stated_exception():
-    result = simulate(STIFF_CHATTER, END_TIME, "standard")
-    errors = errors_against_reference(result, reference_for(STIFF_CHATTER, END_TIME, accuracy="standard"))
-    tolerance = TOLERANCES["standard"]
-    assert errors["F"] <= tolerance["impact_peak"] and errors["peaks"] <= tolerance["impact_peak"], errors
-    assert violations({**errors, "F": 0.0}, "standard") == [], errors  # everything else within the guarantee
-    assert physical_violations(result, tolerance["energy"]) == []
+@pytest.mark.parametrize("name", list(LIGHT_UNDAMPED_WORST))
+def test_light_undamped_absorbers_are_the_stated_exception(name):
+    """The worst scenes measured of the stated exception are within its bounds at `standard`, and everything else
+    within the guarantee; the scene is in the exception (its predicate) and the guarantee alone would refuse it."""
+    scene = LIGHT_UNDAMPED_WORST[name]
+    assert light_undamped_absorber(scene)
+    result = simulate(scene, END_TIME, "standard")
+    errors = errors_against_reference(result, reference_for(scene, END_TIME, accuracy="standard"),
+                                      TOLERANCES["standard"]["time"])
+    assert violations(errors, "standard", LIGHT_UNDAMPED_BOUNDS["standard"]) == [], errors
+    assert violations(errors, "standard") != [], errors  # an exception indeed (else the statement is stale)
+    assert physical_violations(result, TOLERANCES["standard"]["energy"]) == []
+
+
+def test_the_exception_is_a_light_undamped_absorber_on_the_ground():
+    assert light_undamped_absorber(CHATTERING) and light_undamped_absorber(LIGHT_UNDAMPED)
+    assert not light_undamped_absorber(CHATTERING.with_changes(**{"contact.damping_factor": 0.1}))
+    assert not light_undamped_absorber(CHATTERING.with_changes(**{"absorber.damping": 1.0}))
+    assert light_undamped_absorber(CHATTERING.with_changes(**{"recoil_damper.counter_recoil": 1.0}))
+    assert not light_undamped_absorber(model_ii(10.0, 0.0).with_changes(**{
+        "recoil_damper.recoil": 0.0, "recoil_damper.counter_recoil": 0.0, "contact.damping_factor": 0.0,
+        "absorber.damping": 0.0}))
+    assert not light_undamped_absorber(model_i(1.0, 0.0).with_changes(**{
+        "recoil_damper.recoil": 0.0, "recoil_damper.counter_recoil": 0.0, "contact.damping_factor": 0.0,
+        "absorber.damping": 0.0}))
 
 
 @pytest.mark.slow

@@ -52,14 +52,10 @@ def test_the_shipped_scene_is_what_the_script_designs():
     assert comparison.flatness < 0.02  # the issue's criterion, on the realistic system too
 
 
-def test_the_readme_table_of_shots():
+def test_the_burst_peaks_on_the_mount_during_a_recoil():
+    """The force on the mount over the burst peaks at the designed recoil's 43.6 kN (the per-shot table of the user
+    guide's page is checked by tests/docs/test_guide_pages.py)."""
     result = simulate(load_scene(scene_path("realistic")), 7.5)
-    readme = (ROOT / "README.md").read_text()
-    for shot in result.shots:
-        battery = "--" if shot["in_battery_at_next_shot"] is None else ("yes" if shot["in_battery_at_next_shot"] else "no")
-        row = (f"| {shot['shot']} | {shot['time']:.1f} | {1e3 * shot['max_barrel_displacement']:.1f} | {battery} | "
-               f"{shot['time_to_battery']:.3f} |")
-        assert row in readme, row
     assert result.peak_support_force == pytest.approx(43.6e3, rel=1e-3)
 
 

@@ -23,14 +23,9 @@ from ..errors import ClusterError, SceneError, SimulationError, UnitWarning
 from ..scene import load_scene
 from . import run
 from .plugins import add_plugin_argument, load_plugins
-from .sweep import add_set_argument, add_sweep_parser, apply_sets
+from .sweep import ACCURACY_HELP, add_set_argument, add_sweep_parser, apply_sets
 
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
-#: What the accuracy presets mean (mbs_models.engine.accuracy.ACCURACY_PRESETS: the worst relative error of
-#: the max barrel displacement stated there, and the time relative to draft).
-ACCURACY_HELP = ("solver accuracy (default: standard): draft = fast, for plots and exploration (max barrel "
-                 "displacement within 1e-4); standard = results (1e-7, ~1.3x draft's time); reference = "
-                 "validation (1e-9, ~2.9x)")
 _ARGUMENT_NAMES = {"end_time": "--end-time", "accuracy": "--accuracy", "impact_threshold": "--impact-threshold",
                    "user_functions": "--user-functions"}
 
@@ -85,6 +80,8 @@ def _cmd_paper(args) -> int:
         raise SceneError("--workers", f"must be >= 1, got {args.workers}")
     if args.quick and args.reproduce_only:
         raise SceneError("--reproduce-only", "cannot be combined with --quick")
+    from ..outputs import check_output_dir
+    check_output_dir(args.out)  # bad --out: exit 2 before any work; created when the report is written
     if args.quick:
         options = ReportOptions.reduced(workers=args.workers)
     elif args.reproduce_only:
@@ -117,14 +114,14 @@ def _cmd_validate(args) -> int:
 def _cmd_precision(args) -> int:
     from validation.studies.precision import preset_study, run_study
 
-    from ..outputs import prepare_output_dir
+    from ..outputs import check_output_dir
 
     scene = _resolve_scene(args.scene)
     if not 0.0 < args.end_time <= 1e4:
         raise SceneError("end_time", f"must be a number of seconds in (0, 10000], got {args.end_time!r}")
     if args.repeats < 1:
         raise SceneError("--repeats", f"must be a whole number >= 1, got {args.repeats}")
-    out = prepare_output_dir(args.out)
+    out = check_output_dir(args.out)  # bad --out: exit 2 before any work; the study's write() creates it
     start = time.perf_counter()
     progress = _progress()
     if scene.carriage is not None:  # the planar model: its own study against the planar reference
@@ -155,9 +152,9 @@ def _cmd_precision(args) -> int:
 def _cmd_contact_laws(args) -> int:
     from validation.studies.contact_laws import run_study, write
 
-    from ..outputs import prepare_output_dir
+    from ..outputs import check_output_dir
 
-    out = prepare_output_dir(args.out)  # bad --out: exit 2 before any work
+    out = check_output_dir(args.out)  # bad --out: exit 2 before any work; write() creates it
     start = time.perf_counter()
     study = run_study(args.accuracy)
     write(study, out)
@@ -289,7 +286,7 @@ def build_parser() -> argparse.ArgumentParser:
     validate.set_defaults(handler=_cmd_validate)
 
     paper = sub.add_parser("paper", help="reproduce the paper: Table 2 and the figures")
-    paper.add_argument("--out", default="out", help="output directory (default ./out)")
+    paper.add_argument("--out", default="out", help="output directory (created; default ./out)")
     paper.add_argument("--quick", action="store_true",
                        help="a reduced but complete report (coarse gap sweeps, two readings of the paper)")
     paper.add_argument("--reproduce-only", action="store_true",
@@ -302,7 +299,7 @@ def build_parser() -> argparse.ArgumentParser:
     precision = sub.add_parser("precision", help="work-precision study: error vs time of every solver and setting")
     precision.add_argument("scene", nargs="?", default="model_ii",
                            help="scene TOML file or shipped scene (default model_ii: m = 1000 kg, gap 0)")
-    precision.add_argument("--out", default="precision", help="output directory (default ./precision)")
+    precision.add_argument("--out", default="precision", help="output directory (created; default ./precision)")
     precision.add_argument("--quick", action="store_true", help="a tiny grid (seconds instead of minutes)")
     precision.add_argument("--end-time", type=float, default=10.0, help="simulated time in s (default 10)")
     precision.add_argument("--repeats", type=int, default=3, help="timed runs per setting, median taken (default 3)")
@@ -312,7 +309,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     laws = sub.add_parser("contact-laws", help="the contact-law family on a free impact: restitution achieved vs "
                                                "requested (closed form and engine) and force-penetration loops")
-    laws.add_argument("--out", default="contact-laws", help="output directory (default ./contact-laws)")
+    laws.add_argument("--out", default="contact-laws", help="output directory (created; default ./contact-laws)")
     laws.add_argument("--accuracy", default="standard", choices=("draft", "standard", "reference"),
                       help=ACCURACY_HELP)
     laws.add_argument("--json", action="store_true", help="print the study as JSON")
@@ -337,7 +334,7 @@ def build_parser() -> argparse.ArgumentParser:
                              "(default 0.8)")
     design.add_argument("--max-recoil", type=float, default=1.0, help="with --stable: the longest recoil in m the "
                                                                        "gun's clearance allows (default 1.0)")
-    design.add_argument("--out", default="design-brake", help="output directory (default ./design-brake)")
+    design.add_argument("--out", default="design-brake", help="output directory (created; default ./design-brake)")
     design.add_argument("--tolerance", type=float, default=None, metavar="TOL",
                         help="how close (m) the simulated recoil length must come to L: the design length is "
                              "iterated on the simulation until it does (default: 0.1 %% of L, at least 0.1 mm)")

@@ -13,7 +13,7 @@ import sys
 from pathlib import Path
 
 from ..errors import SceneError
-from .sweep import add_worker_timeout_argument
+from .sweep import ACCURACY_HELP, add_worker_timeout_argument
 
 
 def _progress(message: str) -> None:
@@ -22,7 +22,7 @@ def _progress(message: str) -> None:
 
 def _cmd_optimise(args) -> int:
     from . import _resolve_scene
-    from ..outputs import prepare_output_dir
+    from ..outputs import check_output_dir
     from ..studies.backends import check_backend
     from ..studies.optimise import check_problem, optimise, parse_bound
 
@@ -53,7 +53,7 @@ def _cmd_optimise(args) -> int:
         check_backend(args.workers, args.scheduler, args.worker_timeout)
     except SceneError as exc:
         raise SceneError(f"--{exc.key.replace('_', '-')}", exc.message) from None
-    out = prepare_output_dir(Path(args.out))  # bad --out: exit 2 before any simulation
+    out = check_output_dir(Path(args.out))  # bad --out: exit 2 before any simulation; created by write()
     result = optimise(scene, bounds, args.minimise, args.constraint or (), workers=args.workers,
                       scheduler=args.scheduler, worker_timeout=args.worker_timeout, stop_when_final=not args.full_run,
                       progress=_progress, **options)
@@ -77,9 +77,10 @@ def add_parser(sub) -> None:
                      help="metric to minimise, e.g. max_barrel_displacement, peak_support_force")
     opt.add_argument("--constraint", action="append", metavar="METRIC<=VALUE",
                      help="a constraint in SI units, METRIC<=VALUE or METRIC>=VALUE (repeatable)")
-    opt.add_argument("--out", default="optimise", help="output directory (default ./optimise)")
+    opt.add_argument("--out", default="optimise", help="output directory (created; default ./optimise)")
     opt.add_argument("--end-time", type=float, default=10.0, help="simulated time in s (default 10)")
-    opt.add_argument("--accuracy", default="standard", choices=("draft", "standard", "reference"))
+    opt.add_argument("--accuracy", default="standard", choices=("draft", "standard", "reference"),
+                     help=ACCURACY_HELP)
     opt.add_argument("--full-run", action="store_true",
                      help="simulate every point to the end time (default: stop once the metrics are final)")
     opt.add_argument("--seed", type=int, default=1, help="random seed (default 1)")

@@ -13,16 +13,17 @@ from ..errors import SceneError
 
 
 def _cmd_plot_sweep(args) -> int:
-    from ..outputs import prepare_output_dir
+    from ..outputs import check_output_file, prepare_output_file
     from ..results.plotting import save_figure
     from ..results.sweep_plots import plot_sweep, read_sweep_table
 
     out = Path(args.out)
     if out.suffix.lower() != ".png":
         raise SceneError("--out", f"must be a .png file, got {args.out!r}")
+    check_output_file(out, key="--out")
     table = read_sweep_table(args.file)
     drawn = plot_sweep(table, x=args.x, y=args.y, hue=args.hue, kind=args.kind)
-    prepare_output_dir(out.parent if str(out.parent) else Path("."), key="--out")
+    prepare_output_file(out, key="--out")
     save_figure(drawn.figure, out)
     for note in drawn.notes:
         print(f"[recoil] note: {note}", file=sys.stderr)
@@ -47,5 +48,5 @@ def add_parser(sub) -> None:
                                     "trade-off's colour (default: the other varied parameter)")
     plot.add_argument("--kind", default="auto", choices=("auto", "lines", "map", "tradeoff"),
                       help="auto (default): lines, or a map when the hue has more than 8 values")
-    plot.add_argument("--out", required=True, help="PNG file to write")
+    plot.add_argument("--out", required=True, help="PNG file to write (missing directories are created)")
     plot.set_defaults(handler=_cmd_plot_sweep)

@@ -1,7 +1,8 @@
 """``recoil run``: simulate one scene, print its metrics, optionally write the plot and the time histories.
 
 Every output is checked before the solve (exit 2, nothing written, for a figure format other than
-png/pdf/svg or a missing or unwritable directory); unit slips (implausible magnitudes, contacts that can
+png/pdf/svg or a directory that cannot be written or created); a missing directory is created when the file is
+written, after the solve (:mod:`mbs_models.outputs`: the rule of every command); unit slips (implausible magnitudes, contacts that can
 never close: :mod:`mbs_models.engine.unit_slips`) are warned of by ``simulate`` before it solves, one line
 each on stderr.  A run stopped at rest (:mod:`mbs_models.engine.rest`) says so on stderr, in one line.
 """
@@ -30,10 +31,11 @@ def add_parser(sub, accuracy_help: str) -> None:
     run.add_argument("--json", action="store_true", help="print the metrics as one JSON object")
     run.add_argument("--plot", metavar="FILE",
                      help="write the time histories and a zoom on the first impact as a figure; the extension "
-                          "names the format: .png, .pdf or .svg (the directory must exist)")
+                          "names the format: .png, .pdf or .svg (missing directories are created)")
     run.add_argument("--csv", metavar="FILE",
                      help="write the time histories (time, positions, velocities, accelerations, every contact "
-                          "force, the force on the mount, energies) as CSV, units in the header")
+                          "force, the force on the mount, energies) as CSV, units in the header (missing "
+                          "directories are created)")
     run.add_argument("--user-functions", choices=("symbolic", "python"), default=None,
                      help="user-function backend (default symbolic; python is slower, for debugging)")
     run.add_argument("--impact-threshold", type=float, default=1000.0,
@@ -47,7 +49,7 @@ def add_parser(sub, accuracy_help: str) -> None:
 
 def command(args) -> int:
     from ..engine.simulation import simulate
-    from ..outputs import check_output_file
+    from ..outputs import check_output_file, prepare_output_file
     from . import EXIT_OK, _resolve_scene
     from .sweep import apply_sets
 
@@ -64,9 +66,11 @@ def command(args) -> int:
         print(f"recoil: {result.rest_note()}", file=sys.stderr, flush=True)
     if args.plot:
         from ..results.plotting import plot_result, save_figure
+        prepare_output_file(args.plot, key="--plot")
         save_figure(plot_result(result), args.plot)
     if args.csv:
         from ..results.histories import write_histories_csv
+        prepare_output_file(args.csv, key="--csv")
         write_histories_csv(result, args.csv)
     if args.json:
         print(json.dumps(result.metrics(), indent=2, allow_nan=False))

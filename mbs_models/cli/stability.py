@@ -26,7 +26,7 @@ def add_parser(sub, accuracy_help: str) -> None:
 
 def command(args) -> int:
     from ..errors import SceneError
-    from ..outputs import atomic_write_json, atomic_write_text, prepare_output_dir
+    from ..outputs import atomic_write_json, atomic_write_text, check_output_dir, prepare_output_dir
     from ..results.plotting import save_figure
     from ..scene.overrides import parse_spec
     from ..studies.stability_chart import chart_figure, stability_chart, summary_lines
@@ -41,9 +41,10 @@ def command(args) -> int:
         raise SceneError("--elevations", f"must be numbers of degrees, got {args.elevations!r}")
     if not 0.0 < args.end_time <= 1e4:
         raise SceneError("--end-time", f"must be a number of seconds in (0, 10000], got {args.end_time!r}")
-    out = prepare_output_dir(args.out)
+    check_output_dir(args.out)  # bad --out: exit 2 before any work; created once the chart is computed
     points = stability_chart(scene, [float(e) for e in elevations], args.margin, end_time=args.end_time,
                              accuracy=args.accuracy, progress=_progress())
+    out = prepare_output_dir(args.out)
     rows = [p.to_dict() for p in points]
     header = list(rows[0])
     csv_text = ",".join(header) + "\n" + "\n".join(

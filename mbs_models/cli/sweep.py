@@ -26,6 +26,12 @@ import time
 from ..errors import SceneError
 from ..studies.grid import MAX_POINTS
 
+#: What the accuracy presets mean (mbs_models.engine.accuracy.ACCURACY_PRESETS: the worst relative error of
+#: the max barrel displacement stated there, and the time relative to draft).
+ACCURACY_HELP = ("solver accuracy (default: standard): draft = fast, for plots and exploration (max barrel "
+                 "displacement within 1e-4); standard = results (1e-7, ~1.4x draft's time); reference = "
+                 "validation (1e-9, ~1.8x)")
+
 #: run_sweep's argument names -> the options that give them.
 _OPTIONS = {"out": "--out", "scheduler": "--scheduler", "workers": "--workers", "end_time": "--end-time",
             "accuracy": "--accuracy", "params": "--param", "worker_timeout": "--worker-timeout"}
@@ -67,13 +73,14 @@ def add_sweep_parser(sub) -> None:
                             "--param contact.gap=0:0.12:13")
     sweep.add_argument("--out", required=True, metavar="FILE",
                        help="the table: .csv, or .parquet (needs pyarrow); an existing file of the same sweep "
-                            "is resumed")
+                            "is resumed (missing directories are created)")
     sweep.add_argument("--workers", type=int, default=None, metavar="N",
                        help="local worker processes (default: all CPUs)")
     sweep.add_argument("--scheduler", default=None, metavar="ADDRESS",
                        help="run on a Dask cluster: the scheduler's tcp://HOST:PORT (needs the cluster extra)")
     add_worker_timeout_argument(sweep)
-    sweep.add_argument("--accuracy", default="standard", choices=("draft", "standard", "reference"))
+    sweep.add_argument("--accuracy", default="standard", choices=("draft", "standard", "reference"),
+                       help=ACCURACY_HELP)
     sweep.add_argument("--end-time", type=float, default=10.0, help="simulated time in s (default 10)")
     sweep.add_argument("--large", action="store_true",
                        help=f"run a grid of more than {MAX_POINTS:,} points (refused without it: hours to days of "

@@ -8,7 +8,7 @@ effect.  This package finds the tables by itself: adding an effect is adding a m
 term in ``validation/reference/terms/`` and its test file); an element defined outside the package is
 registered with :func:`register_element` (re-exported as ``mbs_models.register_element``).
 
-The README lists the elements and their tables; ``TABLES`` below is the registry.
+The user guide (docs/guide/) and the key reference list the elements and their tables; ``TABLES`` below is the registry.
 
 Importing this package loads neither Exudyn nor the engine.
 """

@@ -71,6 +71,8 @@ class Absorber(Table):
     RULES: ClassVar = {"mass": Rule(0.0, strict=True, unit="kg"), "stiffness": Rule(0.0, unit="N/m"),
                        "damping": Rule(0.0, unit="N s/m")}
     NESTED: ClassVar = {"contact": Contact}
+    KEY_UNITS: ClassVar = {"mount": "text", "name": "text"}
+    CHOICES: ClassVar = {"mount": MOUNTS}
     ROLES: ClassVar = (ABSORBER,)  # its body is an absorber, its contact an absorber's contact
 
     def __post_init__(self):

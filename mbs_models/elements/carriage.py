@@ -55,7 +55,7 @@ from typing import ClassVar
 import numpy as np
 
 from ..errors import SceneError
-from .contact_laws import LAW_FIELDS, LAW_RULES, LawFields, OnsetCapture, law_force
+from .contact_laws import LAW_FIELDS, LAW_KEY_UNITS, LAW_RULES, LawFields, OnsetCapture, law_force
 from .ops import Ops
 from .table import Rule, Table, check_choice, check_derived, check_number, ieee_power
 
@@ -84,9 +84,10 @@ class Support(LawFields, Table):
     position: ``[x, y]`` in m, carriage frame.
     law, stiffness, exponent, damping_factor, restitution, damping, minimum_impact_velocity: the normal contact
         law with the ground (fields as every contact's), penetration ``p = -y`` of the point.
-    friction_coefficient: mu (>= 0) of Coulomb friction against the point's horizontal velocity; or
+    friction_coefficient: mu (>= 0) of Coulomb friction against the point's horizontal velocity; not with
+        the spade's keys below (neither: frictionless).
     horizontal_stiffness, horizontal_damping: k_h (N/m), c_h (N s/m) of a dug-in spade anchored at the point's
-        static x while its normal force is > 0.  Not both; neither: frictionless.
+        static x while its normal force is > 0; not with ``friction_coefficient``.
     friction_velocity: v_reg (m/s, > 0; default 1e-4): the friction is ``mu N u / v_reg`` below it.
     anchor: where a spade's anchor is: ``"rest"`` (default, DESIGN.md: its static x, for good) or ``"touchdown"``
         (where it last touched the ground: after a jump the spade digs in where it lands).
@@ -112,6 +113,9 @@ class Support(LawFields, Table):
                        "friction_velocity": Rule(0.0, strict=True, unit="m/s"),
                        "horizontal_stiffness": Rule(0.0, unit="N/m"),
                        "horizontal_damping": Rule(0.0, unit="N s/m")}
+    KEY_UNITS: ClassVar = {**LAW_KEY_UNITS, "name": "text", "position": "[m, m]", "friction_coefficient": "1",
+                           "anchor": "text"}
+    CHOICES: ClassVar = {**LawFields.CHOICES, "anchor": ANCHORS}
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name.isidentifier():
@@ -178,6 +182,7 @@ class Carriage(Table):
     RULES: ClassVar = {"mass": Rule(0.0, strict=True, unit="kg"), "inertia": Rule(0.0, strict=True, unit="kg m^2"),
                        "barrel_center_of_mass": Rule(unit="m"), "barrel_inertia": Rule(0.0, unit="kg m^2")}
     NESTED_MANY: ClassVar = {"support": Support}
+    KEY_UNITS: ClassVar = {"center_of_mass": "[m, m]", "trunnion": "[m, m]"}
 
     def __post_init__(self):
         object.__setattr__(self, "center_of_mass", _point(f"{self.TABLE}.center_of_mass", self.center_of_mass))

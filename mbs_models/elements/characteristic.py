@@ -229,6 +229,7 @@ class CharacteristicTable(Table):
     points: Any = None
     file: str | None = None
     MANY: ClassVar[bool] = True
+    KEY_UNITS: ClassVar = {"name": "text", "file": "text (a path)"}
     SINCE_VERSION: ClassVar[int] = 2
     COLUMNS: ClassVar[str] = ""
     UNITS: ClassVar[tuple[str, str]] = ("", "")

@@ -329,7 +329,7 @@ class Connector(abc.ABC):
 
     # ------------------------------------------------------------------ bounds
     def force_bound(self, d_bound: float, rate_bound: float, energy: float) -> float:
-        """Bound (N) on |F| when |d| <= ``d_bound`` (m) and |d'| <= ``rate_bound`` (m/s) and the
+        """Bound (N) on ``|F|`` when ``|d| <= d_bound`` (m) and ``|d'| <= rate_bound`` (m/s) and the
         mechanical energy is ``energy`` (J) at most: :meth:`derived_force_bound` unless closed form."""
         return self.derived_force_bound(d_bound, rate_bound)
 
@@ -337,12 +337,12 @@ class Connector(abc.ABC):
     BOUND_SAMPLES = 33
 
     def derived_force_bound(self, d_bound: float, rate_bound: float) -> float:
-        """Bound (N) on |F(d, d')| over the box |d| <= D, |d'| <= V, from the law alone; inf where the box
+        """Bound (N) on ``|F(d, d')|`` over the box ``|d| <= D``, ``|d'| <= V``, from the law alone; inf where the box
         leaves :attr:`coordinate_range` or the law is not finite on it.
 
         * :attr:`monotone` law: ``max(|F(D, V)|, |F(-D, -V)|)``, exact (F is largest at one corner and smallest
           at the opposite one).
-        * otherwise: the largest |F| on a grid of :attr:`BOUND_SAMPLES`^2 points (the corners and edges
+        * otherwise: the largest ``|F|`` on a grid of :attr:`BOUND_SAMPLES` squared points (the corners and edges
           included) plus the largest change of F between neighbouring grid points: a true bound for a law
           monotone on each grid cell (piecewise monotone with its kinks on the grid), an estimate with a
           one-cell Lipschitz margin otherwise.

@@ -39,7 +39,7 @@ end stops): ``law`` (default ``hunt-crossley``) and the law's fields above; fiel
 errors.  Python: ``Contact(gap=0.0, stiffness=2.1e8, exponent=1.3, damping_factor=0.6)``.
 
 Building block: :func:`add_contact` adds a contact of any law between two markers of a caller's own
-Exudyn system (symbolic user function by default); see the README.
+Exudyn system (symbolic user function by default); see the user guide (docs/guide/building-blocks.md).
 """
 
 from __future__ import annotations
@@ -93,6 +93,8 @@ LAW_RULES: dict[str, Rule] = {
     "damping": Rule(0.0, unit="N s/m"),
     "minimum_impact_velocity": Rule(0.0, strict=True, unit="m/s"),
 }
+#: Units of the law's keys whose rule names none (the key reference): the law's name, and pure numbers.
+LAW_KEY_UNITS: dict[str, str] = {"law": "text", "exponent": "1", "restitution": "1"}
 
 
 def _g(z: float) -> float:
@@ -170,6 +172,8 @@ class LawFields:
     """Mixin of tables that carry a contact law (the absorber's contact, the end stops)."""
 
     RULES: ClassVar = LAW_RULES
+    KEY_UNITS: ClassVar = LAW_KEY_UNITS
+    CHOICES: ClassVar = {"law": tuple(CONTACT_LAWS)}
 
     def __post_init__(self):
         super().__post_init__()
@@ -565,6 +569,9 @@ def add_contact(mbs, marker_a, marker_b, contact, *, offset: float | None = None
                 name: str = "contact", sensor: bool = True, install_pre_step: bool = True) -> ContactConnector:
     """Add a contact of any law between two markers of your own Exudyn system; return its connector.
 
+    The returned :class:`ContactConnector` keeps the user function alive: keep it as long as ``mbs``.
+    Call ``mbs.Assemble()`` afterwards as usual.
+
     Parameters
     ----------
     mbs: your ``MainSystem``.
@@ -577,9 +584,6 @@ def add_contact(mbs, marker_a, marker_b, contact, *, offset: float | None = None
     install_pre_step: restitution laws need ``v-`` at each contact onset: install a pre-step function
         that captures it (``connector.update(mbs)``).  If your model has its own pre-step function, pass
         False and call ``connector.update(mbs)`` from it.
-
-    The returned :class:`ContactConnector` keeps the user function alive: keep it as long as ``mbs``.
-    Call ``mbs.Assemble()`` afterwards as usual.
     """
     offset = contact.gap if offset is None else float(offset)
     connector = ContactConnector(name, name, "a", "b", contact, offset)

@@ -141,6 +141,7 @@ class Cradle(Table):
                        "gravity": Rule(0.0, unit="m/s^2"),
                        "friction_coefficient": Rule(0.0),
                        "friction_velocity": Rule(0.0, strict=True, unit="m/s")}
+    KEY_UNITS: ClassVar = {"friction_coefficient": "1"}
 
     # ------------------------------------------------------------------ derived quantities
     def weight_along(self, mass: float) -> float:

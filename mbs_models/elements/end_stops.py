@@ -37,7 +37,19 @@ from .table import Rule, Table
 class _Stop(LawFields, Table):
     """The fields of a stop: its ``position`` (m) and a contact law with the law's fields: ``stiffness``,
     ``exponent``, ``damping_factor``, ``restitution``, ``damping``, ``minimum_impact_velocity`` as the law
-    needs (see :mod:`mbs_models.elements.contact_laws`; default law ``hunt-crossley``)."""
+    needs (see :mod:`mbs_models.elements.contact_laws`; default law ``hunt-crossley``).
+
+    Attributes
+    ----------
+    position: where the stop begins, barrel displacement x_M in m (recoil stop: > 0; battery stop: <= 0).
+    law: the contact law of the stop (the laws of :mod:`mbs_models.elements.contact_laws`).
+    stiffness: k in N/m^exponent (N/m for kelvin-voigt), > 0.
+    exponent: n (> 0) of the power-law laws (not a field of kelvin-voigt).
+    damping_factor: hunt-crossley's lambda in s/m (>= 0).
+    restitution: e in (0, 1] of the restitution laws (lankarani-nikravesh, flores, gonthier, exact-restitution).
+    damping: kelvin-voigt's c in N s/m (>= 0).
+    minimum_impact_velocity: restitution laws: impacts slower than this (m/s, > 0) are damped as at this speed.
+    """
 
     position: float
     law: str = "hunt-crossley"

@@ -106,6 +106,8 @@ class Pulse(Table):
     file: str | None = None
     scale_to_momentum: bool = False
     TABLE: ClassVar[str] = "pulse"
+    KEY_UNITS: ClassVar = {"times": "[s, ...]", "forces": "[N, ...]", "file": "text (a path)",
+                           "scale_to_momentum": "true/false"}
     SINCE_VERSION: ClassVar[int] = 2
 
     def __post_init__(self):
@@ -362,8 +364,7 @@ class BreechForce(Load):
         return self._windows[-1][1]
 
 
-#: A barrel within this distance (m) of its position before the first shot is "in battery".
-BATTERY_TOLERANCE = 1.0e-3
+from ..results.battery import BATTERY_TOLERANCE  # noqa: E402  (1 mm: "in battery", as a single shot's return)
 
 
 def shot_outputs(run) -> list[dict]:
@@ -427,7 +428,13 @@ def shot_lines(shots: list[dict]) -> list[str]:
 
 @dataclass(frozen=True)
 class Burst(Table):
-    """``shots`` shots (integer >= 1) fired every ``interval`` s (> 0): shot k at ``t_k = k * interval``."""
+    """``shots`` shots (integer >= 1) fired every ``interval`` s (> 0): shot k at ``t_k = k * interval``.
+
+    Attributes
+    ----------
+    shots: the number of shots in the burst, an integer >= 1; each is the ``[firing]`` shot.
+    interval: the time between two shots in s (> 0): shot k fires at ``t_k = k * interval`` (k from 0).
+    """
 
     shots: int
     interval: float
@@ -435,6 +442,7 @@ class Burst(Table):
     ORDER: ClassVar[int] = 6
     SINCE_VERSION: ClassVar[int] = 2
     RULES: ClassVar = {"interval": Rule(0.0, strict=True, unit="s")}
+    KEY_UNITS: ClassVar = {"shots": "1"}
     #: ``shots`` (:func:`shot_outputs`): at the top level of ``recoil run --json`` (its key before the
     #: declarations), no sweep column (a list), a line per shot in the summary, for any window simulated.
     OUTPUTS: ClassVar = Outputs(metrics=(Metric("shots", "-", shot_outputs, json_key="shots", column=False,

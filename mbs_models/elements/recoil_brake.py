@@ -45,6 +45,8 @@ from .table import Rule, Table, check_derived, check_number, ieee_power
 #: The two fields that take a number or a table of (stroke, area) pairs.
 AREA_FIELDS = ("orifice_area", "counter_recoil_orifice_area")
 _AREA = Rule(0.0, strict=True, unit="m^2")
+#: The unit of an orifice-area key in the key reference: a number or a table of pairs.
+AREA_UNIT = "m^2, or [[m, m^2], ...]"
 _TABLE_FORM = "a number (m^2) or a table of (stroke m, area m^2) pairs, e.g. [[0.0, 3e-4], [0.3, 1e-4]]"
 
 
@@ -140,6 +142,7 @@ class BrakeBand(Table):
     TABLE: ClassVar[str] = "band"
     SINCE_VERSION: ClassVar[int] = 2
     RULES: ClassVar = {"up_to": Rule(-90.0, unit="degrees", maximum=90.0)}
+    KEY_UNITS: ClassVar = {name: AREA_UNIT for name in AREA_FIELDS}
 
     def __post_init__(self):
         super().__post_init__()
@@ -180,6 +183,7 @@ class RecoilBrake(Table):
     RULES: ClassVar = {"piston_area": Rule(0.0, strict=True, unit="m^2"),
                        "discharge_coefficient": Rule(0.0, strict=True, maximum=1.0),
                        "fluid_density": Rule(0.0, strict=True, unit="kg/m^3")}
+    KEY_UNITS: ClassVar = {**{name: AREA_UNIT for name in AREA_FIELDS}, "discharge_coefficient": "1"}
 
     def __post_init__(self):
         super().__post_init__()

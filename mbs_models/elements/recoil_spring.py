@@ -17,7 +17,12 @@ from .table import Rule, Table
 
 @dataclass(frozen=True)
 class RecoilSpring(Table):
-    """Recoil spring between ground and barrel, stiffness ``k`` in N/m (Eq. 1)."""
+    """Recoil spring between ground and barrel, stiffness ``k`` in N/m (Eq. 1).
+
+    Attributes
+    ----------
+    stiffness: k in N/m (>= 0; 0 = no spring), the linear spring's force ``k x_M`` returning the barrel.
+    """
 
     stiffness: float
     TABLE: ClassVar[str] = "recoil_spring"

@@ -103,6 +103,7 @@ class Recuperator(Table):
                        "piston_area": Rule(0.0, strict=True, unit="m^2"),
                        "gas_volume": Rule(0.0, strict=True, unit="m^3"),
                        "polytropic_exponent": Rule(POLYTROPIC_RANGE[0], maximum=POLYTROPIC_RANGE[1])}
+    KEY_UNITS: ClassVar = {"polytropic_exponent": "1"}
 
     # ------------------------------------------------------------------ the law in plain numbers
     @property

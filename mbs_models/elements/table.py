@@ -16,7 +16,6 @@ A table built in Python is checked exactly like one read from TOML; every error 
 
 from __future__ import annotations
 
-import difflib
 import math
 import sys
 from dataclasses import dataclass, fields
@@ -119,6 +118,8 @@ def check_choice(key: str, value, allowed: Iterable[str], what: str = "value") -
 def suggestion(word: str, allowed: Iterable[str]) -> str:
     """``"; did you mean 'x'?"`` for the closest allowed word, else ``"; allowed: a, b, c"``."""
     allowed = sorted(allowed)
+    import difflib  # (here: a misspelt key is rare, the import is not free)
+
     close = difflib.get_close_matches(word, allowed, n=1, cutoff=0.6)
     if close:
         return f"; did you mean {close[0]!r}?"
@@ -153,6 +154,10 @@ class Table:
         :data:`~mbs_models.elements.declaration.END_STOP`); none by default.
     OUTPUTS: the element's declared histories and metrics (:mod:`~mbs_models.elements.declaration`); none by
         default.
+    KEY_UNITS: field name -> unit of a key whose ``RULES`` entry names none (``"1"`` dimensionless, ``"text"``,
+        ``"true/false"``, the form of a table of pairs); with the ``Attributes`` section of the class docstring
+        (one entry per key) it makes the key reference (:mod:`mbs_models.scene.keys`).
+    CHOICES: field name -> the allowed strings of a key that is a choice (the tuple its check uses).
     """
 
     TABLE: ClassVar[str] = ""
@@ -164,6 +169,8 @@ class Table:
     NESTED_MANY: ClassVar[dict[str, type]] = {}
     ROLES: ClassVar[tuple[str, ...]] = ()
     OUTPUTS: ClassVar[Outputs] = NO_OUTPUTS
+    KEY_UNITS: ClassVar[dict[str, str]] = {}
+    CHOICES: ClassVar[dict[str, tuple[str, ...]]] = {}
 
     def __post_init__(self):
         for name, rule in self.RULES.items():

@@ -53,6 +53,7 @@ class TabulatedDamper(CharacteristicTable):
     """
 
     TABLE: ClassVar[str] = "tabulated_damper"
+    KEY_UNITS: ClassVar = {**CharacteristicTable.KEY_UNITS, "points": "[[m/s, N], ...]"}
     ORDER: ClassVar[int] = 45
     COLUMNS: ClassVar[str] = "velocity,force"
     UNITS: ClassVar[tuple[str, str]] = UNITS

@@ -62,6 +62,7 @@ class TabulatedSpring(CharacteristicTable):
     """
 
     TABLE: ClassVar[str] = "tabulated_spring"
+    KEY_UNITS: ClassVar = {**CharacteristicTable.KEY_UNITS, "points": "[[m, N], ...]"}
     ORDER: ClassVar[int] = 44
     COLUMNS: ClassVar[str] = "displacement,force"
     UNITS: ClassVar[tuple[str, str]] = UNITS

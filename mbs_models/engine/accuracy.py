@@ -121,7 +121,7 @@ def _positive(key: str, value, upper: float, lower: float = 0.0) -> None:
 #: Accuracy presets, chosen by the work-precision study (``recoil precision --presets``,
 #: :mod:`validation.studies.precision`).  All use adaptive DOPRI5 with symbolic user functions: on these
 #: models it reaches any error level cheaper than ODE23, the fixed-step and the implicit solvers, and
-#: scipy (see the README).  Worst relative error on the 19 paper cases (max barrel displacement / peak
+#: scipy (see the performance pages).  Worst relative error on the 19 paper cases (max barrel displacement / peak
 #: contact force / max absorber velocity), measured -> stated (tests/test_presets.py):
 #:
 #: * ``draft``:     9.7e-6 / 1.4e-4 / 5.6e-5 -> 1e-4 / 1e-3 / 1e-3 (plots, exploration; max step 20 ms);

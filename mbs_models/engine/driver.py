@@ -50,8 +50,8 @@ MAX_CONTACT_RETRIES = 3
 #: Re-solves (with max_step / 4 each) when an adaptive solve diverged (NaN or inf in its output).
 MAX_DIVERGENCE_RETRIES = 3
 #: The finality tracker (stop_when_final) is shown the state at every this-many-th step: an observed step's
-#: pre-step call (reading the state, the bounds) costs ~10 us inside a solve, a step ~5 us (README, cost
-#: section; scripts/bench_prestep.py).  Changing it changes when early stops happen (not bit-identical).
+#: pre-step call (reading the state, the bounds) costs ~10 us inside a solve, a step ~5 us (the performance
+#: pages; scripts/bench_prestep.py).  Changing it changes when early stops happen (not bit-identical).
 OBSERVE_EVERY = 4
 #: Most output samples kept for fixed-step solvers (output is thinned beyond this, and beyond
 #: :func:`~mbs_models.engine.guard.sample_cap` for a scene with many sensors).
@@ -126,7 +126,8 @@ def _absolute_tolerance_settings(settings: SolverSettings) -> SolverSettings | N
                    absolute_tolerance=settings.absolute_tolerance + settings.relative_tolerance)
 
 
-def _pre_step_function(assembly: Assembly, budget: StepBudget | None, tracker: FinalityTracker | None):
+def _pre_step_function(assembly: Assembly, budget: StepBudget | None, tracker: FinalityTracker | None,
+                       specialise: bool = True):
     """Exudyn pre-step function: the step budget (raises when spent), the contacts' onset capture and
     the finality tracker.
 
@@ -144,7 +145,9 @@ def _pre_step_function(assembly: Assembly, budget: StepBudget | None, tracker: F
     at :attr:`~mbs_models.engine.guard.StepBudget.next_check`) and the tracker's cadence; the state is read
     only for the captures or an observed step, and passed on as it is where Exudyn's coordinates are the
     bodies in body order (else reordered).  With the budget alone (most adaptive solves) the function only
-    counts: one Python call, an increment and a comparison per step (~0.2 us; README, "Limits").
+    counts: one Python call, an increment and a comparison per step (~0.2 us; the validation pages, "Limits"); with the budget and
+    the tracker alone (a sweep's early stop) it counts and observes every :data:`OBSERVE_EVERY`-th step.
+    ``specialise=False``: the general function in every case (the same calls of the budget and the tracker).
     """
     data = assembly.mbs.systemData
     read_positions, read_velocities = data.GetODE2Coordinates, data.GetODE2Coordinates_t
@@ -206,7 +209,26 @@ def _pre_step_function(assembly: Assembly, budget: StepBudget | None, tracker: F
             return not observe(t, q, v)
         return not observe(t, [q[i] for i in order], [v[i] for i in order])
 
-    function = count if budget is not None and not captures and observe is None and planar is None else pre_step
+    def count_and_observe(mbs, t):  # the budget and the tracker alone (a sweep's early stop): pre_step's work
+        nonlocal steps, next_check
+        steps += 1
+        if steps >= next_check:
+            if not budget.advance(steps, t):
+                raise _BudgetSpent(f"step budget spent at t = {t:.6g} s")
+            next_check = budget.next_check
+        if steps % OBSERVE_EVERY:
+            return True
+        return not observe(t, read_positions(copy=False).tolist(), read_velocities(copy=False).tolist())
+
+    if specialise and budget is not None and not captures and planar is None:
+        if observe is None:
+            function = count
+        elif in_body_order:
+            function = count_and_observe
+        else:
+            function = pre_step
+    else:
+        function = pre_step
     function.new_solve = solver.clear  # a segmented run calls it before each segment's solve
     return function
 

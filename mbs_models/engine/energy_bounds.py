@@ -490,15 +490,15 @@ class EnergyBounds:
         return bound
 
     def body_velocity(self, i: int, energy: float) -> float:
-        """Bound (m/s) on |v_i|."""
+        """Bound (m/s) on ``|v_i|``."""
         return math.sqrt(2.0 / self.masses[i] * self._excess(energy))
 
     def velocity_from_own_energy(self, i: int, own: float) -> float:
-        """Bound (m/s) on |v_i| of a free oscillator from its own energy ``own`` (J, >= 0)."""
+        """Bound (m/s) on ``|v_i|`` of a free oscillator from its own energy ``own`` (J, >= 0)."""
         return math.sqrt(2.0 / self.masses[i] * max(own, 0.0))
 
     def contact_coordinate(self, j: int, energy: float) -> float:
-        """Bound (m) on contact ``j``'s relative coordinate |d| (= x_M - x_m for an absorber) from the springs
+        """Bound (m) on contact ``j``'s relative coordinate ``|d|`` (= x_M - x_m for an absorber) from the springs
         (from its potential well: ``max(|lo|, |hi|)``)."""
         if self._in_well(self.contacts[j]):
             return self.well.magnitude(self.contacts[j], self._excess(energy))
@@ -531,7 +531,7 @@ class EnergyBounds:
         return min(contact.penetration_bound(e), relative - contact.offset)
 
     def penetration_rate(self, j: int, energy: float) -> float:
-        """Bound (m/s) on contact ``j``'s |p'|."""
+        """Bound (m/s) on contact ``j``'s ``|p'|``."""
         return math.sqrt(self._rate_coefficients[j] * self._excess(energy))
 
     def contact_force_bound(self, j: int, energy: float) -> float:
@@ -542,7 +542,7 @@ class EnergyBounds:
         return self.contacts[j].force_bound(p, self.penetration_rate(j, energy), energy)
 
     def support_force_bound(self, energy: float) -> float:
-        """Bound (N) on |S|: the sum of the force bounds of the connectors touching the ground."""
+        """Bound (N) on ``|S|``: the sum of the force bounds of the connectors touching the ground."""
         e = self._excess(energy)
         total = 0.0
         contact_index = {id(c): j for j, c in enumerate(self.contacts)}

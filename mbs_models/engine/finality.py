@@ -50,6 +50,8 @@ STOP_AT_REST = StopReason.AT_REST
 #: The metrics :meth:`FinalityTracker.check` decides together.
 _CONTACT_METRICS = ("peak_contact_force", "impacts", "max_absorber_velocity")
 _CONTACT_METRICS_SET = frozenset(_CONTACT_METRICS)
+#: :meth:`FinalityTracker.check`'s metrics left when the barrel's maximum is the only one
+_BARREL_ONLY = ["max_barrel_displacement"]
 
 
 def check_metric_names(names, key: str = "stop_when_final") -> tuple[str, ...]:
@@ -156,22 +158,28 @@ class FinalityTracker:
             if magnitude > self.max_support_force:
                 self.max_support_force = magnitude
         if self.enabled:
-            self.check(t, x, v, forces, self.requested)
+            self.check(t, x, v, forces, self.requested, rising=x[0] >= self.max_barrel_position and v[0] > 0.0)
         return self.done
 
-    def check(self, t: float, x, v, forces, names: Iterable[str] = FINAL_METRICS) -> None:
+    def check(self, t: float, x, v, forces, names: Iterable[str] = FINAL_METRICS, *, rising: bool = False) -> None:
         """Mark those of ``names`` that the energy at this state (contact forces ``forces`` N, in
-        :attr:`EnergyBounds.contacts` order) proves final."""
+        :attr:`EnergyBounds.contacts` order) proves final.
+
+        ``rising``: the barrel is at the largest x_M seen and moving on (v_M > 0): x_M exceeds that maximum
+        right after this instant, so no bound that holds can prove it final here; ``max_barrel_displacement``
+        is not evaluated then (nor the energy, when it is the only metric left: most observed states of a
+        sweep's early stop, during the recoil)."""
         if not self.enabled or t < self.after:
             return
         # (the requested names not final yet are kept by _mark: not filtered again at every observed state)
         todo = self._pending if names is self.requested else [name for name in names if name not in self.final]
-        if not todo:
+        if not todo or (rising and todo == _BARREL_ONLY):
             return
         bounds = self.bounds
         energy = bounds.with_slack(bounds.energy(x, v))
         newly = []
-        if "max_barrel_displacement" in todo and bounds.barrel_displacement(energy) <= self.max_barrel_position:
+        if ("max_barrel_displacement" in todo and not rising
+                and bounds.barrel_displacement(energy) <= self.max_barrel_position):
             newly.append("max_barrel_displacement")
         # the contact metrics are decided together (as they are cheap together): all of them as soon as
         # any is pending

@@ -120,7 +120,7 @@ def simulate(scene: Scene, end_time: float = 10.0, accuracy: str | SolverSetting
     Raises
     ------
     SceneError: an argument is invalid, or a fixed step is unsafe for the scene (the message names it
-        and gives the safe limit), or the run is beyond a bound (README, "Limits"): a spring or damper too
+        and gives the safe limit), or the run is beyond a bound (the validation pages, "Limits"): a spring or damper too
         stiff for the step budget (the message names the key and the largest value that fits), more than
         :data:`MAX_ABSORBERS` absorbers, more than :data:`MAX_SEGMENTS` segments.
     SimulationError: the solve failed, stopped early, produced non-finite values, stepped over a

@@ -13,6 +13,7 @@ Nothing is clamped or refused: the run goes on with the values as given.
 
 from __future__ import annotations
 
+import functools
 import itertools
 import warnings
 from typing import Any, Mapping, Sequence
@@ -23,10 +24,31 @@ from ..scene.plausibility import implausible_magnitudes
 from .reach import contacts_out_of_reach
 
 
+#: Scenes whose findings :func:`unit_slips` keeps (the most recently used): a loop of runs of a few scenes.
+CACHED_SCENES = 64
+
+
 def unit_slips(scene: Scene) -> list:
     """The findings of ``scene`` (each with ``key`` and ``message()``): its implausible magnitudes, then its
-    contacts out of reach; [] for a plausible scene."""
+    contacts out of reach; [] for a plausible scene.
+
+    The findings depend on the scene's values alone (frozen tables) and are immutable: those of the last
+    :data:`CACHED_SCENES` scenes are kept (by equality of the scenes: the same values), so that a loop of
+    ``simulate`` calls on the same scenes checks each once; a scene that cannot be hashed is checked anew."""
+    try:
+        return list(_cached_unit_slips(scene))
+    except TypeError:  # an unhashable value in a table (a plugin element's list)
+        return _unit_slips(scene)
+
+
+def _unit_slips(scene: Scene) -> list:
+    """:func:`unit_slips` computed anew."""
     return [*implausible_magnitudes(scene), *contacts_out_of_reach(scene)]
+
+
+@functools.lru_cache(maxsize=CACHED_SCENES)
+def _cached_unit_slips(scene: Scene) -> tuple:
+    return tuple(_unit_slips(scene))
 
 
 def grid_unit_slips(scene: Scene, grid: Mapping[str, Sequence[Any]]) -> list:

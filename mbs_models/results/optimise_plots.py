@@ -9,6 +9,8 @@ the first two parameters coloured by the metric -- with the optimum as a red sta
 
 from __future__ import annotations
 
+import textwrap
+
 import numpy as np
 from matplotlib.figure import Figure
 
@@ -55,9 +57,17 @@ def plot_optimisation(result) -> Figure:
 
     draw_design_space(axes[0, 1], result)
     state = "" if result.feasible else " -- NO FEASIBLE DESIGN FOUND"
-    fig.suptitle(f"minimise {result.minimise} over {', '.join(keys)} (base scene: {result.scene.name}){state}",
-                 fontsize=11)
+    title = f"minimise {result.minimise} over {', '.join(keys)} (base scene: {result.scene.name}){state}"
+    fig.suptitle(wrap_to_figure(title, fig, fontsize=11), fontsize=11)
     return fig
+
+
+def wrap_to_figure(text: str, fig: Figure, fontsize: float) -> str:
+    """``text`` broken into lines that fit the width of ``fig``: at most ``width / (0.6 fontsize)`` characters
+    a line (an average character of the sans-serif font is about 0.55 of its size; the figure's width in
+    points over that), so that a long title is wrapped instead of clipped at the figure's edges."""
+    characters = int(fig.get_figwidth() * 72.0 / (0.6 * fontsize))
+    return "\n".join(textwrap.wrap(text, width=max(characters, 20)))
 
 
 def draw_design_space(ax, result, *, colorbar: bool = True) -> None:

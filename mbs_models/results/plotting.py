@@ -171,7 +171,7 @@ def plot_barrel_displacements(results: Sequence[Result], *, title: str) -> Figur
     for result in results:
         colour = MODEL_COLOURS.get(result.scene.model_label)
         ax.plot(result.time, result.barrel_position * 1e3, color=colour,
-                label=f"{result.scene.model_label}: max {result.max_barrel_displacement:.4f} m")
+                label=f"{result.scene.model_label}: max {result.max_barrel_displacement * 1e3:.1f} mm")
         ax.plot([result.time_of_max_barrel_displacement], [result.max_barrel_displacement * 1e3], "o",
                 color=colour, ms=4)
     ax.set_xlabel("time [s]")

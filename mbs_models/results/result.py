@@ -81,7 +81,7 @@ class Result:
     use the dictionaries).
 
     Metrics (refined between output samples, see :mod:`mbs_models.results.peaks`):
-    ``max_barrel_displacement`` (m, Table 2) and its time; ``peak_support_force`` (largest |S|, N) and its
+    ``max_barrel_displacement`` (m, Table 2) and its time; ``peak_support_force`` (largest ``|S|``, N) and its
     time; ``peak_contact_force`` (N) and ``max_absorber_velocity`` (m/s), the largest over all absorbers,
     with their times; ``impacts`` (all absorbers' impacts in time order); ``dissipated_energy`` (J per
     dissipating connector at the end time); :meth:`absorbers`, :meth:`stops`, :meth:`energy` per element.
@@ -323,6 +323,25 @@ class Result:
             return None
         return bool(self.time_of_max_barrel_displacement >= self.time[-1] and self.barrel_velocity[-1] > 0.0)
 
+    @property
+    def time_to_battery(self) -> float | None:
+        """A single shot's return (s after the shot at t = 0): the first time ``t >= t_max`` at which the barrel is
+        back within :data:`~mbs_models.results.battery.BATTERY_TOLERANCE` (1 mm) of its position at t = 0,
+
+            ``x_M(t) <= x_M(0) + 1e-3 m``,  ``t_max`` = :attr:`time_of_max_barrel_displacement`,
+
+        found on the output samples and refined on the cubic Hermite interpolant of ``(x_M, v_M)`` (as each shot's
+        ``time_to_battery`` of a burst; ``t_max`` itself when the maximum is within 1 mm).  None with a burst
+        (each shot's is in ``shots``), when the maximum is not reported (an early stop that did not prove it) or
+        is the end of the window, or when the barrel is not back within the window."""
+        from .battery import return_to_battery
+
+        if getattr(self.scene, "burst", None) is not None or self.max_barrel_displacement is None \
+                or self.max_at_end_of_window:
+            return None
+        return return_to_battery(self.time, self.barrel_position, self.barrel_velocity,
+                                 self.time_of_max_barrel_displacement, self.max_barrel_displacement)
+
     def maxima_at_end_of_window(self) -> list[str]:
         """The peak metrics whose maximum is the window's last instant (still rising there, so not a turning
         point): ``max_barrel_displacement`` as :attr:`max_at_end_of_window` says, and ``peak_support_force``,
@@ -351,6 +370,7 @@ class Result:
             "time_of_max_barrel_displacement": self.time_of_max_barrel_displacement,
             "max_at_end_of_window": self.max_at_end_of_window,
             "maxima_at_end_of_window": self.maxima_at_end_of_window(),
+            "time_to_battery": self.time_to_battery,
             "peak_support_force": self.peak_support_force,
             "time_of_peak_support_force": self.time_of_peak_support_force,
             "peak_contact_force": self.peak_contact_force,
@@ -459,6 +479,11 @@ class Result:
                          f"{self.time_of_max_barrel_displacement:.5f} s{end_note('max_barrel_displacement')}")
         else:
             lines.append(f"  max barrel displacement  {not_final}")
+        if getattr(self.scene, "burst", None) is None:   # a burst: per shot, below
+            back = self.time_to_battery
+            lines.append("  back in battery          " + (f"{back:.5f} s (within 1 mm)" if back is not None else
+                                                         "not within the window" if self.max_barrel_displacement
+                                                         is not None else not_final))
         if self.peak_support_force is not None:
             lines.append(f"  peak support force       {self.peak_support_force / 1e3:.3f} kN at "
                          f"{self.time_of_peak_support_force:.5f} s{end_note('peak_support_force')}")

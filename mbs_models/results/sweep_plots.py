@@ -10,7 +10,8 @@ Three figures:
 
 * :func:`plot_lines` -- a metric against one parameter, one line per value of a second (the paper's
   Figs 4/5: barrel displacement against the gap, one line per absorber mass);
-* :func:`plot_map` -- a metric over two parameters: a heat map with labelled contour lines;
+* :func:`plot_map` -- a metric over two parameters: a heat map of cells around the grid points, with labelled
+  contour lines where the grid is fine enough (:data:`MIN_CONTOUR_VALUES`);
 * :func:`plot_tradeoff` -- the designer's trade-off: peak force on the mount against the recoil length
   (max barrel displacement), every point coloured by a parameter, with the Pareto front (the points
   that no other point beats on both).
@@ -25,6 +26,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from matplotlib import patheffects
 from matplotlib.figure import Figure
 
 from ..errors import SceneError
@@ -217,14 +219,34 @@ def plot_lines(table, x: str, y: str = "max_barrel_displacement", hue: str | Non
     return SweepFigure(fig, "lines", x, y, hue, len(rows), notes)
 
 
+#: Contour lines are drawn only on a grid of at least this many values along each parameter: a contour
+#: interpolates linearly between neighbouring points, and across a coarser grid (100/500/1000 kg) the lines
+#: would show a shape the data do not have.  A coarser map shows its cells with the value written in each.
+MIN_CONTOUR_VALUES = 5
+
+
+def cell_edges(values: np.ndarray) -> np.ndarray:
+    """The edges of the cells of a map around sorted grid ``values``: half-way between neighbours inside,
+    the first and last values themselves outside (the map never reaches beyond the data).  A single value
+    gets a cell of +-5 % of itself (+-0.5 for 0) so that it can be drawn."""
+    values = np.asarray(values, dtype=float)
+    if len(values) == 1:
+        half = 0.05 * abs(values[0]) or 0.5
+        return np.array([values[0] - half, values[0] + half])
+    return np.concatenate([values[:1], (values[1:] + values[:-1]) / 2.0, values[-1:]])
+
+
 def plot_map(table, x: str, hue: str, y: str = "max_barrel_displacement", *, levels: int = 8,
              title: str | None = None) -> SweepFigure:
-    """``y`` over the parameters ``x`` (horizontal) and ``hue`` (vertical): heat map and contour lines.
+    """``y`` over the parameters ``x`` (horizontal) and ``hue`` (vertical): one cell per grid point, with
+    contour lines on a fine grid.
 
     The table must hold a grid (every combination of the two parameters' values at most once); a
-    combination without a usable row is a blank cell.  ``levels`` contour lines are drawn at evenly
-    spaced values of ``y`` (fewer when the grid is too small to contour: fewer than two points along
-    a parameter).
+    combination without a usable row is a blank cell.  Cells are bounded half-way between neighbouring
+    values and by the first and last values (:func:`cell_edges`): the axes span the data, no more; each grid
+    point is marked.  ``levels`` contour lines are drawn at evenly spaced values of ``y`` when each parameter
+    has at least :data:`MIN_CONTOUR_VALUES` values; on a coarser grid each cell is labelled with its value
+    instead (and a note says why there are no contour lines).
     """
     rows, notes = usable_rows(table, [x, hue, y])
     if rows.empty:
@@ -242,15 +264,33 @@ def plot_map(table, x: str, hue: str, y: str = "max_barrel_displacement", *, lev
     fig, axes = new_figure(1, 1, row_height=4.4)
     ax = axes[0, 0]
     ax.grid(False)
-    mesh = ax.pcolormesh(xs, hs, values, shading="nearest", cmap="viridis")
+    x_edges, h_edges = cell_edges(xs), cell_edges(hs)
+    mesh = ax.pcolormesh(x_edges, h_edges, values, shading="flat", cmap="viridis")
     fig.colorbar(mesh, ax=ax, label=y_label)
+    gx, gh = np.meshgrid(xs, hs)
+    drawn = ~np.ma.getmaskarray(values)
+    ax.plot(gx[drawn], gh[drawn], "o", color="white", mec="black", ms=3.5, mew=0.6, ls="none", clip_on=False)
+    ax.set_xlim(x_edges[0], x_edges[-1])
+    ax.set_ylim(h_edges[0], h_edges[-1])
     contours = None
-    if len(xs) >= 2 and len(hs) >= 2 and values.count() >= 4 and values.max() > values.min():
+    fine = len(xs) >= MIN_CONTOUR_VALUES and len(hs) >= MIN_CONTOUR_VALUES
+    if fine and values.count() >= 4 and values.max() > values.min():
         contours = ax.contour(xs, hs, values, levels=np.linspace(values.min(), values.max(), levels + 2)[1:-1],
                               colors="white", linewidths=0.8)
         ax.clabel(contours, fontsize=7, fmt="%.4g")
     else:
-        notes.append("no contour lines: the grid needs at least two values of each parameter")
+        notes.append(f"no contour lines: drawn on a grid of at least {MIN_CONTOUR_VALUES} values of each "
+                     f"parameter (this one has {len(xs)} x {len(hs)}); each cell shows its value")
+        if values.count() <= 100:
+            for (i, j), value in np.ndenumerate(values.filled(np.nan)):
+                if np.isfinite(value):
+                    # inside its cell: the label of a point on the map's edge points inwards
+                    left, right = j == 0 and len(xs) > 1, j == len(xs) - 1 and len(xs) > 1
+                    top = i == len(hs) - 1 and len(hs) > 1
+                    ax.annotate(f"{value:.4g}", (xs[j], hs[i]), xytext=(4 * left - 4 * right, -5 if top else 5),
+                                textcoords="offset points", ha="left" if left else "right" if right else "center",
+                                va="top" if top else "bottom", fontsize=7, color="white",
+                                path_effects=[patheffects.withStroke(linewidth=2, foreground="black")])
     ax.set_xlabel(x_label)
     ax.set_ylabel(h_label)
     ax.set_title(title or f"{y.replace('_', ' ')} over {x} and {hue}", fontsize=11)

@@ -30,22 +30,24 @@ PAPER_ROUNDED_INITIAL_VELOCITY = 0.7
 
 @dataclass(frozen=True)
 class Conventions:
-    """Alternative readings of the paper's text; all off by default (see the README and the report).
+    """Alternative readings of the paper's text; all off by default (see the user guide and the report).
 
     Each flag reproduces one literal reading that the validation report studies.  They concern the
     paper's contact at wall A (the absorbers' contacts):
 
-    * ``literal_lambda_sign`` -- Eq. (6) taken literally with delta_dot = x_m' - x_M': the damping term
-      becomes ``(1 - lambda p_dot)``, i.e. it *adds* energy during compression (hunt-crossley only).
-    * ``compression_only`` -- "the contact force will only act ... when delta and delta_dot are
-      negative": force only while the penetration grows (p_dot > 0), none during restitution
-      (hunt-crossley, one absorber).
-    * ``v0_includes_absorber`` -- model (i): the absorber rides on the barrel, so the projectile
-      momentum accelerates ``M + m`` (Section 2.1, "this will affect the initial velocity").
-    * ``rounded_initial_velocity`` -- use the paper's printed v0 = 0.7 m/s instead of the exact
-      momentum balance (0.6909 m/s for Table 1).
-    * ``literal_gap_sign`` -- delta = x_m - (x_M + gap) taken literally: the gap then acts as an
-      initial interference, ``p = (x_M - x_m) + gap``.
+    Attributes
+    ----------
+    literal_lambda_sign: Eq. (6) taken literally with delta_dot = x_m' - x_M': the damping term
+        becomes ``(1 - lambda p_dot)``, i.e. it *adds* energy during compression (hunt-crossley only).
+    compression_only: "the contact force will only act ... when delta and delta_dot are
+        negative": force only while the penetration grows (p_dot > 0), none during restitution
+        (hunt-crossley, one absorber).
+    v0_includes_absorber: model (i): the absorber rides on the barrel, so the projectile
+        momentum accelerates ``M + m`` (Section 2.1, "this will affect the initial velocity").
+    rounded_initial_velocity: use the paper's printed v0 = 0.7 m/s instead of the exact
+        momentum balance (0.6909 m/s for Table 1).
+    literal_gap_sign: delta = x_m - (x_M + gap) taken literally: the gap then acts as an
+        initial interference, ``p = (x_M - x_m) + gap``.
     """
 
     literal_lambda_sign: bool = False
@@ -55,6 +57,9 @@ class Conventions:
     literal_gap_sign: bool = False
 
     TABLE = "conventions"
+    #: every flag is a boolean (the key reference, :mod:`mbs_models.scene.keys`)
+    KEY_UNITS = {name: "true/false" for name in ("literal_lambda_sign", "compression_only", "v0_includes_absorber",
+                                                 "rounded_initial_velocity", "literal_gap_sign")}
 
     def __post_init__(self):
         for f in fields(self):

@@ -53,6 +53,8 @@ def simplified_model(conventions: Conventions | None = None) -> Scene:
         |           |  M   |---> x_M   (v0 from the shot)
         |---[ c ]---+------+
         ground   c = 6239 (x_M' > 0) / 14050 (x_M' < 0) N s/m
+
+    with Table 1's barrel, recoil spring and recoil damper.
     """
     return Scene(name="simplified model", **_barrel_parts(conventions))
 

@@ -26,7 +26,6 @@ the values a sweep gives a key: ``100,500,1000`` or ``START:STOP:COUNT`` (both e
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import fields, replace
 from typing import Any, Mapping
 
@@ -284,6 +283,8 @@ def parse_value(text: str, key: str = "") -> Any:
     if not stripped:
         raise SceneError(key, "no value given")
     check_toml_nesting(stripped, key, "the value")  # before the parser recurses once per level
+    import tomllib  # (imported here: only a value given as text is parsed)
+
     try:
         value = tomllib.loads(f"value = {stripped}")["value"]
     except tomllib.TOMLDecodeError:

@@ -296,14 +296,14 @@ def compare_with_linear_damper(scene: Scene, recoil_length: float, accuracy: str
 
 
 def plot_comparison(comparison: Comparison):
-    """Resistance vs stroke of the designed brake and the linear damper (peak support force in the legend)."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    """Resistance vs stroke of the designed brake and the linear damper (peak support force in the legend).  A
+    matplotlib ``Figure`` of its own (no pyplot state: nothing is left open, the caller's backend unchanged)."""
+    from matplotlib.figure import Figure
 
     from .recoil_peaks import RECOIL, peak_forces
 
-    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.2))
+    fig = Figure(figsize=(11, 4.2))
+    left, right = fig.subplots(1, 2)
     for result, label, style in ((comparison.designed, "designed brake (constant resistance)", "-"),
                                  (comparison.linear, f"linear damper x {comparison.damper_scale:.3g}", "--")):
         x, r = recoil_stroke(result)

@@ -35,7 +35,7 @@ from typing import Any, Callable, Iterable, Iterator, Mapping, Sequence
 import numpy as np
 import pandas as pd
 
-from ..outputs import atomic_write_with
+from ..outputs import atomic_write_with, check_output_dir, prepare_output_dir
 from ..errors import RecoilError, SceneError
 from .point import STATUS_COLUMNS
 from .table_rows import Unreadable, check_rows, csv_chunks, csv_text, is_count, is_text, read_header
@@ -136,8 +136,9 @@ def _inferred_kind(values: pd.Series) -> str:
 
 
 def check_out(path: str | os.PathLike) -> Path:
-    """``path`` checked as a sweep's output file: ``.csv`` or ``.parquet`` (with pyarrow installed), in an
-    existing directory, not a directory itself."""
+    """``path`` checked as a sweep's output file: ``.csv`` or ``.parquet`` (with pyarrow installed), not a
+    directory itself, in a writable directory or one that can be created (:func:`~mbs_models.outputs.check_output_dir`;
+    :class:`SweepFile` creates it)."""
     path = Path(path)
     fmt = FORMATS.get(path.suffix.lower())
     if fmt is None:
@@ -151,9 +152,8 @@ def check_out(path: str | os.PathLike) -> Path:
     if path.is_dir():
         raise SceneError("out", f"{path} is a directory, not a file")
     parent = path.parent if str(path.parent) else Path(".")
-    if not parent.is_dir():
-        raise SceneError("out", f"the directory {parent} does not exist")
-    if not os.access(parent, os.W_OK) or (path.exists() and not os.access(path, os.W_OK)):
+    check_output_dir(parent, "out")
+    if (parent.exists() and not os.access(parent, os.W_OK)) or (path.exists() and not os.access(path, os.W_OK)):
         raise SceneError("out", f"cannot write to {path}")
     return path
 
@@ -165,6 +165,7 @@ class SweepFile:
     def __init__(self, path: str | os.PathLike, params: Sequence[str], metrics: Sequence[str], *,
                  kinds: Mapping[str, str] | None = None, chunk_rows: int = CHUNK_ROWS, sync_interval: float = 1.0):
         self.path = check_out(path)
+        prepare_output_dir(self.path.parent if str(self.path.parent) else Path("."), "out")
         self.format = FORMATS[self.path.suffix.lower()]
         self.params, self.metrics = list(params), list(metrics)
         self.kinds = dict(kinds) if kinds is not None else None

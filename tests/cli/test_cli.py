@@ -153,7 +153,33 @@ def test_version_prints_the_package_version():
     assert proc.returncode == 0 and proc.stdout.strip() == f"recoil {__version__}"
 
 
-@pytest.mark.parametrize("command", ["run", "validate", "contact-laws", "design-brake"])
+def _subparsers(parser):
+    """Every (name, parser) of ``parser``'s subcommands, nested ones included."""
+    import argparse
+
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for name, sub in action.choices.items():
+                yield name, sub
+                yield from ((f"{name} {inner}", p) for inner, p in _subparsers(sub))
+
+
+def test_every_option_of_every_subcommand_has_help():
+    import argparse
+
+    from mbs_models.cli import build_parser
+
+    parser = build_parser()
+    commands = [("recoil", parser), *_subparsers(parser)]
+    assert len(commands) > 10  # the walk found the subcommands
+    missing = [f"{name} {action.option_strings[0] if action.option_strings else action.dest}"
+               for name, command in commands for action in command._actions
+               if not isinstance(action, (argparse._SubParsersAction,)) and not (action.help or "").strip()]
+    assert missing == []
+
+
+@pytest.mark.parametrize("command", ["run", "validate", "contact-laws", "design-brake", "sweep", "optimise",
+                                     "stability"])
 def test_accuracy_help_shows_the_default_and_what_each_preset_means(capsys, command):
     with pytest.raises(SystemExit) as exit_info:
         main([command, "--help"])
@@ -308,3 +334,63 @@ def test_an_accuracy_warning_is_one_line(capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 0 and any("energy balance is off" in line for line in err), err
     assert all(line.startswith("recoil: warning: ") for line in err), err
+
+
+#: Per command writing files: arguments that write into the directory OUT (not yet there), and arguments with
+#: one bad input (an option out of range, an unknown metric or file...) that must leave nothing behind.
+_WRITERS = {
+    "run": (["run", "model_ii", "--end-time", "0.2", "--accuracy", "draft", "--plot", "OUT/r.png", "--csv",
+             "OUT/r.csv"], ["run", "model_ii", "--end-time", "-1", "--plot", "OUT/r.png"]),
+    "sweep": (["sweep", "model_i", "--param", "contact.gap=0", "--end-time", "0.2", "--accuracy", "draft",
+               "--workers", "1", "--out", "OUT/s.csv"],
+              ["sweep", "model_i", "--param", "contact.gap=zero", "--out", "OUT/s.csv"]),
+    "plot-sweep": (["plot-sweep", "TABLE", "--out", "OUT/p.png"], ["plot-sweep", "NO_TABLE.csv", "--out", "OUT/p.png"]),
+    "optimise": (["optimise", "model_i", "--vary", "contact.gap=0:0.1", "--minimise", "max_barrel_displacement",
+                  "--popsize", "2", "--maxiter", "1", "--workers", "1", "--end-time", "1", "--out", "OUT"],
+                 ["optimise", "model_i", "--vary", "contact.gap=0:0.1", "--minimise", "no_such_metric",
+                  "--out", "OUT"]),
+    "design-brake": (["design-brake", "simplified", "--recoil-length", "0.15", "--end-time", "3", "--accuracy",
+                      "draft", "--out", "OUT"], ["design-brake", "simplified", "--recoil-length", "-1", "--out", "OUT"]),
+    "stability": (["stability", "towed_howitzer", "--elevations", "0", "--end-time", "0.5", "--accuracy", "draft",
+                   "--out", "OUT"], ["stability", "towed_howitzer", "--end-time", "-1", "--out", "OUT"]),
+    "precision": (["precision", "--quick", "--end-time", "0.5", "--repeats", "1", "--out", "OUT"],
+                  ["precision", "--repeats", "0", "--out", "OUT"]),
+    "contact-laws": (["contact-laws", "--accuracy", "draft", "--out", "OUT"],
+                     ["contact-laws", "--accuracy", "rough", "--out", "OUT"]),
+    # its run (a report, seconds) is tests/validation/studies/test_report.py's, written into a new directory
+    "paper": (None, ["paper", "--workers", "0", "--out", "OUT"]),
+}
+
+
+def _argv(argv, tmp_path):
+    table = tmp_path / "table" / "s.csv"
+    return [a.replace("OUT", str(tmp_path / "new" / "deeper")).replace("NO_TABLE", str(tmp_path / "none"))
+            .replace("TABLE", str(table)) for a in argv]
+
+
+def test_every_command_that_writes_is_listed():
+    from mbs_models.cli import build_parser
+
+    parser = build_parser()
+    writers = {name for name, command in _subparsers(parser)
+               if any(a.dest in ("out", "plot", "csv") for a in command._actions)}
+    assert writers == set(_WRITERS)
+
+
+@pytest.mark.parametrize("command", sorted(_WRITERS))
+def test_bad_input_leaves_no_directory_behind(tmp_path, capsys, command):
+    assert main(_argv(_WRITERS[command][1], tmp_path)) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("recoil: error:") and "Traceback" not in err
+    assert not (tmp_path / "new").exists()
+
+
+@pytest.mark.parametrize("command", sorted(name for name, (good, _) in _WRITERS.items() if good is not None))
+def test_missing_output_directories_are_created(tmp_path, capsys, command):
+    """One rule for every command: a missing output directory is created (with its parents)."""
+    if command == "plot-sweep":
+        assert main(["sweep", "model_i", "--param", "contact.gap=0,0.01", "--end-time", "0.2", "--accuracy", "draft",
+                     "--workers", "1", "--out", str(tmp_path / "table" / "s.csv")]) == 0
+    assert main(_argv(_WRITERS[command][0], tmp_path)) == 0
+    written = [p for p in (tmp_path / "new" / "deeper").iterdir() if not p.name.startswith(".")]
+    assert written, f"{command} wrote nothing into the new directory"

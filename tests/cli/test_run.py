@@ -51,12 +51,30 @@ def test_another_figure_format_is_refused_before_the_solve(tmp_path, capsys, no_
 
 
 @pytest.mark.parametrize("option, name", [("--plot", "run.png"), ("--csv", "run.csv")])
-def test_a_missing_directory_is_refused_and_not_created(tmp_path, capsys, no_solve, option, name):
-    target = tmp_path / "no" / "such" / "dir" / name
+def test_a_directory_that_cannot_be_created_is_refused_before_the_solve(tmp_path, capsys, no_solve, option, name):
+    (tmp_path / "a_file").write_text("")
+    target = tmp_path / "a_file" / "dir" / name
     assert main(["run", "model_ii", option, str(target)]) == 2
     [line] = capsys.readouterr().err.strip().splitlines()
-    assert line.startswith(f"recoil: error: {option}:") and "does not exist" in line
-    assert list(tmp_path.iterdir()) == []
+    assert line.startswith(f"recoil: error: {option}:") and "not a writable directory" in line
+    assert [p.name for p in tmp_path.iterdir()] == ["a_file"]
+
+
+def test_missing_directories_are_created_once_the_run_has_solved(tmp_path, capsys, monkeypatch):
+    import mbs_models.engine.simulation as simulation
+
+    solve, seen = simulation.simulate, []
+
+    def solve_and_look(*args, **kwargs):
+        seen.append((tmp_path / "plots").exists() or (tmp_path / "tables").exists())
+        return solve(*args, **kwargs)
+
+    monkeypatch.setattr(simulation, "simulate", solve_and_look)
+    plot, table = tmp_path / "plots" / "a" / "run.png", tmp_path / "tables" / "run.csv"
+    assert main(["run", "model_ii", "--end-time", "0.2", "--accuracy", "draft", "--plot", str(plot),
+                 "--csv", str(table)]) == 0
+    assert seen == [False]   # nothing created before the solve
+    assert plot.read_bytes()[:8] == _PNG and table.read_text().startswith("time")
 
 
 def test_a_directory_as_csv_target_is_refused(tmp_path, capsys, no_solve):

@@ -65,8 +65,9 @@ def test_bad_input_exits_2_with_one_line(tmp_path, capsys, argv, needle):
 
 
 @pytest.mark.parametrize("out, needle", [("s.txt", "--out: must be a .csv or .parquet file"),
-                                         ("missing/s.csv", "--out: the directory")])
+                                         ("a_file/s.csv", "--out: "), ("a_file/deeper/s.csv", "--out: ")])
 def test_bad_out_exits_2(tmp_path, capsys, out, needle):
+    (tmp_path / "a_file").write_text("")
     assert main(["sweep", "model_i", "--param", "contact.gap=0", "--out", str(tmp_path / out)]) == 2
     assert needle in capsys.readouterr().err
 

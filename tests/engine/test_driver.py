@@ -148,3 +148,27 @@ def test_a_segment_ending_a_round_off_short_of_its_end_ends_at_it():
     assert time[-1] != 0.75  # the solver's array itself is not changed
     early = np.array([0.5, 0.6, 0.7])
     assert np.array_equal(_ending_at((early, values), 0.75)[0], early)
+
+
+def test_the_specialised_pre_step_functions_stop_where_the_general_one_does(monkeypatch):
+    """The pre-step function made for a run's case (the budget alone; the budget and the tracker) gives the runs of
+    the general one: the same steps, early stops and values (Figs 4/5 points with and without the early stop)."""
+    from mbs_models import model_i, model_ii, simulate
+    from mbs_models.engine import driver
+
+    runs = [(model(mass, gap), metrics) for model in (model_i, model_ii) for mass in (100.0, 1000.0)
+            for gap in (0.0, 0.08) for metrics in ((), ("max_barrel_displacement",))]
+
+    def outcomes():
+        out = []
+        for scene, metrics in runs:
+            result = simulate(scene, 2.0, "standard", stop_when_final=metrics)
+            out.append((result.end_time, result.steps, result.stop_reason, result.max_barrel_displacement,
+                        result.peak_contact_force, result.barrel_position.tolist()))
+        return out
+
+    specialised = outcomes()
+    general = driver._pre_step_function
+    monkeypatch.setattr(driver, "_pre_step_function",
+                        lambda assembly, budget, tracker: general(assembly, budget, tracker, specialise=False))
+    assert outcomes() == specialised

@@ -226,3 +226,29 @@ def test_sweep_with_early_stop_gives_the_same_displacements():
     assert [p.stop_reason for p in early] == ["metrics_final", "metrics_final", "end_time_no_energy_bound"]
     assert early[0].end_time < 2.0 and early[0].impacts is None and early[0].peak_contact_force is None
     assert early[2].end_time == 4.0 and early[2].impacts == full[2].impacts
+
+
+def test_skipping_the_barrels_bound_while_it_rises_stops_where_evaluating_it_does(monkeypatch):
+    """While the barrel is at its largest x_M and moving on, the tracker does not evaluate the barrel's bound (it
+    cannot prove the maximum there): the early stops of the Figs 4/5 points, and of a run asking for every metric,
+    are those of a tracker that evaluates it at every observed state (same end, steps, final metrics, values)."""
+    from mbs_models import model_i, model_ii, simulate
+    from mbs_models.engine.finality import FINAL_METRICS, FinalityTracker
+
+    runs = [(model(mass, gap), ("max_barrel_displacement",)) for model in (model_i, model_ii)
+            for mass in (100.0, 1000.0) for gap in (0.0, 0.08)] + [(model_ii(500.0, 0.04), FINAL_METRICS)]
+
+    def outcomes():
+        out = []
+        for scene, metrics in runs:
+            result = simulate(scene, 10.0, "standard", stop_when_final=metrics)
+            out.append((result.end_time, result.steps, result.stop_reason, result.final_metrics,
+                        result.max_barrel_displacement, result.peak_contact_force))
+        return out
+
+    skipping = outcomes()
+    evaluate = FinalityTracker.check
+    monkeypatch.setattr(FinalityTracker, "check", lambda self, *args, rising=False, **kwargs: evaluate(self, *args, **kwargs))
+    every_state = outcomes()
+    assert skipping == every_state
+    assert all(result[2] == "metrics_final" for result in skipping)

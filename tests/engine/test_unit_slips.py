@@ -80,3 +80,22 @@ def test_optimise_warns_before_its_first_point(monkeypatch):
     with pytest.warns(UnitWarning, match=r"^absorber\.contact\.gap = 40 m"):
         with pytest.raises(AssertionError, match="the optimiser ran"):
             optimise(model_ii(), {"contact.gap": (0.0, 40.0)}, "max_barrel_displacement", workers=1)
+
+
+def test_kept_findings_equal_those_checked_anew_and_warn_at_every_call():
+    """The findings kept per scene (``unit_slips``) are those computed anew (``_unit_slips``), for equal scenes
+    built apart too, and every ``simulate`` of a kept scene still warns."""
+    from mbs_models.engine import unit_slips as module
+
+    scenes = [model_ii(1000.0, 40.0).with_changes(**{"barrel.mass": 5.6}), model_ii(1000.0, 0.04), model_i(100.0, 80.0)]
+    for scene in scenes + [model_ii(1000.0, 40.0).with_changes(**{"barrel.mass": 5.6})]:  # the last: equal, not same
+        first, again, fresh = unit_slips(scene), unit_slips(scene), module._unit_slips(scene)
+        assert first == again == fresh
+        assert [f.message() for f in again] == [f.message() for f in fresh]
+    assert module._cached_unit_slips.cache_info().hits >= 4
+    kept = unit_slips(scenes[0])
+    kept.clear()  # a caller's list: the kept findings are not changed through it
+    assert unit_slips(scenes[0]) == module._unit_slips(scenes[0])
+    for _ in range(2):
+        with pytest.warns(UnitWarning, match=r"^absorber\.contact\.gap = 80 m is beyond"):
+            simulate(model_i(100.0, 80.0), 0.05, "draft")

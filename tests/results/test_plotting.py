@@ -73,3 +73,21 @@ def test_a_declared_history_with_a_panel_gets_one_after_the_velocities(monkeypat
     expected = scene.recoil_spring.stiffness * result.barrel_position / 1e3
     assert np.asarray(line.get_ydata()) == pytest.approx(expected, rel=1e-12, abs=1e-12)
     assert axes[3].get_xlabel() == "time [s]" and axes[2].get_xlabel() == ""
+
+
+def test_the_barrel_displacement_legends_are_in_the_axis_unit():
+    """Figs 6-8: the y axis is in mm, so the legend's maximum is too (it once gave metres)."""
+    import re
+
+    from mbs_models.results.plotting import plot_barrel_displacements
+
+    results = [simulate(simplified_model(), 0.6, "draft"), simulate(model_ii(), 0.6, "draft")]
+    ax = plot_barrel_displacements(results, title="t").axes[0]
+    assert ax.get_ylabel().endswith("[mm]")
+    labels = [text.get_text() for text in ax.get_legend().get_texts()]
+    assert len(labels) == 2
+    for label, result in zip(labels, results):
+        value, unit = re.search(r"max ([\d.]+) (\w+)", label).groups()
+        assert unit == "mm", label
+        # printed to 0.1 mm: within half of that of the result's maximum in mm
+        assert abs(float(value) - result.max_barrel_displacement * 1e3) <= 0.05 + 1e-9, label

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import pytest
+
 from mbs_models import model_ii, simplified_model, simulate
 
 
@@ -102,3 +104,27 @@ def test_state_at_gives_the_histories_at_any_sampling_interval_from_the_samples_
         assert np.array_equal(at_samples["absorber"], result.positions["absorber"][distinct])
         with pytest.raises(ValueError, match="state_at: times must lie in"):
             result.state_at([result.time[-1] + 1.0])
+
+
+def test_a_single_shot_returns_to_battery_as_the_closed_form_says():
+    """``time_to_battery``: the simplified model is a linear spring-damper on each side of its maximum, solved in
+    closed form (tests/battery_return.py).  At ``standard`` the engine's metrics are within ~1e-7 (its claim);
+    1e-6 leaves room for the crossing's refinement on the Hermite interpolant."""
+    from battery_return import simplified_return
+
+    scene = simplified_model()
+    t_max, x_max, t_back = simplified_return(scene)
+    result = simulate(scene, 5.0)
+    assert result.max_barrel_displacement == pytest.approx(x_max, rel=1e-6)   # the closed form is this model's
+    assert result.time_to_battery == pytest.approx(t_back, rel=1e-6)
+    assert result.metrics()["time_to_battery"] == result.time_to_battery
+    assert f"back in battery          {t_back:.5f} s" in result.summary()
+
+
+def test_no_time_to_battery_before_the_barrel_is_back():
+    """A window that ends before the return (the closed form's 1.79 s) gives None, not the window's end."""
+    short = simulate(simplified_model(), 1.5, "draft")
+    assert short.max_barrel_displacement is not None and short.time_to_battery is None
+    assert "back in battery          not within the window" in short.summary()
+    rising = simulate(simplified_model(), 0.05, "draft")          # the maximum is not a turning point yet
+    assert rising.time_to_battery is None

@@ -91,6 +91,31 @@ def test_map_has_heat_map_and_the_requested_contours():
     _png_ok(drawn.figure)
 
 
+def test_a_coarse_map_keeps_its_axes_on_the_grid_and_draws_no_contours():
+    """Masses 100/500/1000 kg once gave an axis from -100 to 1250 kg and contours interpolated across the cells."""
+    drawn = plot_map(_table(), "contact.gap", "absorber.mass", "peak_support_force")
+    ax = drawn.figure.axes[0]
+    # the cells' edges: half-way between the values, the outer ones at the first and last value
+    assert ax.get_ylim() == pytest.approx((100.0, 1000.0))
+    assert ax.get_xlim() == pytest.approx((0.0, 120.0))  # gaps 0 ... 0.12 m, in mm
+    (mesh,) = [c for c in ax.collections if isinstance(c, QuadMesh)]
+    corners = mesh.get_coordinates()
+    np.testing.assert_allclose(corners[:, 0, 1], [100.0, 300.0, 750.0, 1000.0])
+    assert drawn.contours is None and "no contour lines" in drawn.notes[-1]
+    # each cell says its value (force = 7000 - 2 m + 10000 g N, in kN)
+    texts = {t.get_text() for t in ax.texts}
+    assert f"{(7000 - 2 * 500 + 10000 * 0.04) * 1e-3:.4g}" in texts and len(texts) <= len(GAPS) * len(MASSES)
+    _png_ok(drawn.figure)
+
+
+def test_the_axes_of_a_fine_map_lie_within_the_cell_edges():
+    drawn = plot_map(_table(masses=np.linspace(100, 2000, 5)), "contact.gap", "absorber.mass")
+    ax = drawn.figure.axes[0]
+    assert 100.0 <= ax.get_ylim()[0] < ax.get_ylim()[1] <= 2000.0
+    assert 0.0 <= ax.get_xlim()[0] < ax.get_xlim()[1] <= 120.0
+    assert drawn.contours is not None
+
+
 def test_tradeoff_front_is_the_non_dominated_points():
     force = np.array([5.0, 4.0, 6.0, 3.0, 3.5])
     length = np.array([1.0, 2.0, 2.5, 3.0, 4.0])

@@ -115,3 +115,19 @@ def test_the_text_names_the_asked_and_achieved_length_and_each_peak_s_phase(tmp_
     linear = data["linear_damper"]
     assert linear["peak_support_force_in_recoil"] < 0.5 * linear["peak_support_force"]
     assert linear["peaks"]["mount"]["phase"] == "counter-recoil" and linear["peaks"]["mount"]["into_buffer"]
+
+
+def test_the_comparison_figure_leaves_no_pyplot_figure_open(comparison):
+    """The figure is a Figure of its own: a caller's pyplot (a notebook, the docs' gallery) gets no stray figure
+    and keeps its backend."""
+    import matplotlib
+    import matplotlib.pyplot as plt
+
+    from mbs_models.studies.brake_design import plot_comparison
+
+    backend = matplotlib.get_backend()
+    open_before = plt.get_fignums()
+    fig = plot_comparison(comparison)
+    assert len(fig.axes) == 2
+    assert plt.get_fignums() == open_before
+    assert matplotlib.get_backend() == backend

@@ -89,12 +89,21 @@ def test_files_honour_the_umask(tmp_path, suffix, mask, mode):
         assert stat.S_IMODE(path.stat().st_mode) == mode, path.name
 
 
-@pytest.mark.parametrize("name, needle", [("t.txt", ".csv or .parquet"), ("missing/t.csv", "does not exist"),
-                                          (".", "directory")])
+@pytest.mark.parametrize("name, needle", [("t.txt", ".csv or .parquet"), ("a_file/t.csv", "not a directory"),
+                                          ("a_file/deeper/t.csv", "not a writable directory"), (".", "directory")])
 def test_bad_paths(tmp_path, name, needle):
+    (tmp_path / "a_file").write_text("")
     with pytest.raises(SceneError, match=needle) as info:
         check_out(tmp_path / name if name != "." else tmp_path)
     assert info.value.key == "out"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a_file"]   # nothing created
+
+
+def test_a_missing_directory_is_checked_without_being_created_and_made_by_the_file(tmp_path):
+    target = tmp_path / "new" / "deeper" / "t.csv"
+    assert check_out(target) == target and not (tmp_path / "new").exists()
+    SweepFile(target, ["contact.gap"], ["max_barrel_displacement"])
+    assert target.parent.is_dir()
 
 
 def test_parquet_without_pyarrow_names_the_extra(tmp_path, monkeypatch):

@@ -602,6 +602,25 @@ class ReferenceResult:
         """Time (s) of :attr:`max_barrel_displacement`."""
         return self._barrel_max[0] if self._final("max_barrel_displacement") else None
 
+    @property
+    def time_to_battery(self) -> float | None:
+        """Time (s after the shot at t = 0) a single shot's barrel is back in battery (DESIGN.md, "Outputs every
+        scene gets"): the first ``t >= t_max`` (the time of :attr:`max_barrel_displacement`) with
+        ``x_M(t) <= x_M(0) + BATTERY_TOLERANCE``, by a scan of the dense output and ``brentq``; ``t_max`` when the
+        maximum is already that low.  None with a burst (see :attr:`shots`), when the maximum is not final, when
+        the maximum is the end of the window with the barrel still moving out, or when it is not back by
+        ``end_time``."""
+        if self.model.shot_times is not None or not self._final("max_barrel_displacement"):
+            return None
+        t_max, x_max = self._barrel_max
+        first, last = self.segments[0], self.segments[-1]
+        if t_max >= last.t1 and float(last.sol(last.t1)[1]) > 0.0:
+            return None
+        level = float(first.sol(first.t0)[0]) + BATTERY_TOLERANCE
+        if x_max <= level:
+            return t_max
+        return _first_below(self.segments, t_max, level)
+
     def _largest(self, pairs, metric: str):
         pairs = list(pairs)
         return _best(pairs) if pairs and self._final(metric) else None
@@ -703,6 +722,7 @@ class ReferenceResult:
             "impacts": impacts(self.impacts),
             "peak_support_force": self.peak_support_force,
             "time_of_peak_support_force": self.time_of_peak_support_force,
+            "time_to_battery": self.time_to_battery,
             "absorbers": [{**asdict(m), "impacts": impacts(m.impacts)} for m in self.absorber_metrics],
             "stops": {name: contact(m) for name, m in self.stop_metrics.items()},
             "end_time": self.end_time,

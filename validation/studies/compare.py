@@ -73,6 +73,8 @@ DEFAULT_TOLERANCES = {
     "peak_contact_force": 1e-3,
     "max_absorber_velocity": 1e-3,
     "time_of_max_absorber_velocity": 1e-2,
+    # a single shot's return to battery (within 1 mm): a time, as the time of the maximum
+    "time_to_battery": 1e-3,
     # max error of a time history on a common grid, relative to the history's largest magnitude
     "position_history": 1e-3,
     # the carriage (scenes with [carriage]); the support forces relative to the support's static load (the largest
@@ -123,7 +125,7 @@ class QuantityCheck:
 def quantity_unit(name: str) -> str:
     """``s`` for a time, ``N`` for a force, ``m/s`` for a velocity, ``rad`` for a pitch, ``1`` for a margin, ``m``
     for a displacement, a position or a lift."""
-    if name.startswith("time_of_") or name.endswith("_time"):
+    if name.startswith(("time_of_", "time_to_")) or name.endswith("_time"):
         return "s"
     if "pitch" in name:
         return "rad"
@@ -281,7 +283,7 @@ def compare_results(engine: Result, reference: ReferenceResult, tolerances: dict
     tolerances = {**tolerances_for(accuracy), **(tolerances or {})}
     checks = []
     for name in ("max_barrel_displacement", "time_of_max_barrel_displacement", "peak_support_force",
-                 "peak_contact_force", "max_absorber_velocity", "time_of_max_absorber_velocity"):
+                 "peak_contact_force", "max_absorber_velocity", "time_of_max_absorber_velocity", "time_to_battery"):
         ours, theirs = getattr(engine, name), getattr(reference, name)
         checks.append(QuantityCheck(name, ours, theirs, _relative(ours, theirs), tolerances[name]))
     if len(engine.contacts) > 1:

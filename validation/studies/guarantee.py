@@ -1,7 +1,7 @@
-"""What the README guarantees per accuracy preset, and the checks of an engine result behind it.
+"""What the documentation guarantees per accuracy preset, and the checks of an engine result behind it.
 
-The README's "What is guaranteed" section states, per preset, the largest errors of an engine result
-against the independent reference (:data:`TOLERANCES`); ``tests/test_readme.py`` keeps the README's
+The user guide's accuracy page (docs/guide/accuracy.md) states, per preset, the largest errors of an engine
+result against the independent reference (:data:`TOLERANCES`); ``tests/docs/test_guide_pages.py`` keeps its
 table equal to this dictionary, and the hard cases and property tests check every result with
 :func:`errors_against_reference`, :func:`violations` and :func:`physical_violations`.
 """
@@ -16,7 +16,7 @@ import numpy as np
 from ..reference import solve_reference
 
 #: Largest errors accepted per preset: a margin over the maxima measured on the hard cases and on the
-#: random scenes of the property tests (the README's "What is guaranteed" states them).
+#: random scenes of the property tests (the validation pages' "What is guaranteed" states them).
 #:
 #: * ``energy``: max over the run of |kinetic + stored + dissipated - initial energy| / initial energy;
 #: * ``metric``: relative error of the max barrel displacement and the max absorber velocity, and the
@@ -29,6 +29,23 @@ TOLERANCES = {
     "standard": {"energy": 5e-6, "metric": 1e-5, "force": 2e-5, "impact_peak": 1e-4, "time": 2e-5},
     "reference": {"energy": 5e-9, "metric": 2e-7, "force": 3e-7, "impact_peak": 5e-6, "time": 1e-6},
 }
+#: The stated exception: an absorber on the ground lighter than :data:`LIGHT_UNDAMPED_MASS` whose damper and
+#: contact damping are both zero chatters hundreds of times a second on a stiff contact, with penetrations so small
+#: that the positions' absolute error is a large part of them (a force ``k d^n`` has the relative error
+#: ``n (position error) / d``).  At ``standard`` such a scene is held to these bounds instead of :data:`TOLERANCES`
+#: for the keys named (the rest unchanged): bounds over a grid of such scenes, not proven for every one;
+#: ``tests/test_properties.py`` leaves the region out of the random scenes and pins the grid's worst scenes.
+LIGHT_UNDAMPED_MASS = 10.0
+LIGHT_UNDAMPED_BOUNDS = {"standard": {"metric": 1e-4, "force": 1e-3, "impact_peak": 1e-3, "time": 5e-4}}
+
+
+def light_undamped_absorber(scene) -> bool:
+    """True if ``scene`` lies in the stated exception: an absorber on the ground lighter than
+    :data:`LIGHT_UNDAMPED_MASS` kg whose damper and contact damping factor are both zero."""
+    return any(a.mount == "ground" and a.mass < LIGHT_UNDAMPED_MASS and a.damping == 0.0
+               and a.contact.damping_factor == 0.0 for a in scene.absorbers)
+
+
 #: Impacts whose rise (the peak above the force at rest the episode began with) lies within this fraction of the
 #: threshold are ambiguous (either side may count).
 THRESHOLD_BAND = 1e-2
@@ -175,9 +192,10 @@ def errors_against_reference(result, ref, merge_gap: float = 0.0) -> dict:
     return out
 
 
-def violations(errors: dict, accuracy: str) -> list[str]:
-    """The errors of :func:`errors_against_reference` that exceed the preset's :data:`TOLERANCES` (empty: all within)."""
-    tol = TOLERANCES[accuracy]
+def violations(errors: dict, accuracy: str, bounds: dict | None = None) -> list[str]:
+    """The errors of :func:`errors_against_reference` that exceed the preset's :data:`TOLERANCES`, updated by
+    ``bounds`` (``{key: bound}``, e.g. the stated exception's :data:`LIGHT_UNDAMPED_BOUNDS`) (empty: all within)."""
+    tol = {**TOLERANCES[accuracy], **(bounds or {})}
     out = []
     if errors["impact_mismatch"]:
         out.append(f"impacts: {errors['impact_mismatch']} present on one side only")

@@ -1,7 +1,7 @@
 """The hard cases of the guarantee: corners of the scene space where solvers struggle.
 
-Each :class:`HardCase` is a scene, a run length and the reference's options.  The README's "What is
-guaranteed" section states the tolerances (:mod:`validation.studies.guarantee`) that the engine meets on
+Each :class:`HardCase` is a scene, a run length and the reference's options.  The validation pages' "What is
+guaranteed" states the tolerances (:mod:`validation.studies.guarantee`) that the engine meets on
 every case at every preset against the independent reference (``tests/test_hard_cases.py``).
 """
 

@@ -993,7 +993,7 @@ def run_study(scene: Scene, settings: Sequence[Setting] | None = None, *, end_ti
 # Accuracy presets on the paper cases
 
 #: Relative errors each preset is stated to meet on all 19 paper cases (max barrel displacement, peak
-#: contact force, max absorber velocity), measured by :func:`preset_study` (README, "Accuracy presets").
+#: contact force, max absorber velocity), measured by :func:`preset_study` (docs/guide/accuracy.md).
 PRESET_ERROR_BOUNDS: dict[str, dict[str, float]] = {
     "draft": {"max_barrel_displacement": 1e-4, "peak_contact_force": 1e-3, "max_absorber_velocity": 1e-3},
     "standard": {"max_barrel_displacement": 1e-7, "peak_contact_force": 1e-6, "max_absorber_velocity": 1e-5},
@@ -1062,7 +1062,7 @@ class PresetStudy:
         return problems
 
     def table_markdown(self) -> str:
-        """The README table: preset, solver settings, worst relative errors, median time per run."""
+        """The presets table: preset, solver settings, worst relative errors, median time per run."""
         n = len(next(iter(self.cases.values())))
         lines = [f"| preset | solver settings | worst relative error on the {n} paper cases: displacement / "
                  "force / absorber velocity | stated bound | median time per "

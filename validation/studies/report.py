@@ -36,7 +36,7 @@ import numpy as np
 
 from mbs_models import model_i, model_ii, simplified_model, simulate
 from mbs_models.scene.models import model_i as _model_i_doc, model_ii as _model_ii_doc, simplified_model as _simp_doc
-from mbs_models.outputs import atomic_write_json, atomic_write_text, prepare_output_dir
+from mbs_models.outputs import atomic_write_json, atomic_write_text, check_output_dir, prepare_output_dir
 from mbs_models.scene import Scene
 from mbs_models.studies.sweep import default_workers, process_pool, run_sweep_jobs, sweep_jobs
 
@@ -730,15 +730,20 @@ color:#222;line-height:1.45}
 h1{font-size:1.6em}h2{border-bottom:2px solid #ddd;padding-bottom:.2em;margin-top:2em}
 table{border-collapse:collapse;margin:1em 0;font-size:.92em}th,td{border:1px solid #ccc;padding:.3em .6em;
 text-align:left;vertical-align:top}th{background:#f3f3f3}td.n,th.n{text-align:right}td.n{white-space:nowrap}
-.scroll{max-width:100%;overflow-x:auto}#tab-conventions td:first-child{min-width:14em}
+.scroll{max-width:100%;overflow-x:auto}#tab-conventions td:first-child{min-width:12em}
+#tab-conventions,#tab-conventions-trend,#tab-engine-vs-reference{font-size:.85em}
+#tab-conventions th,#tab-engine-vs-reference th{vertical-align:bottom}
 pre{background:#f7f7f7;padding:.8em;max-width:100%;box-sizing:border-box;overflow-x:auto;font-size:.85em}
 pre.wrap{white-space:pre-wrap;overflow-wrap:anywhere}
-figure{margin:1.2em 0}figure img{max-width:100%;border:1px solid #eee}figcaption{font-size:.9em;color:#555}
+figure{margin:1.2em 0}figure img{max-width:100%;height:auto;border:1px solid #eee}
+figcaption{font-size:.9em;color:#555}
 .bad{color:#b00020;font-weight:600}.good{color:#1b7f2a;font-weight:600}.bad,.good{white-space:nowrap}
 .note{background:#fff8e1;padding:.6em 1em;border-left:4px solid #f0c000}
 dl.meta{display:grid;grid-template-columns:max-content 1fr;gap:.15em 1em;font-size:.92em;margin:1em 0}
 dl.meta dt{font-weight:600;color:#555}dl.meta dd{margin:0;overflow-wrap:anywhere}
 #summary{font-size:1.05em;background:#f3f7fb;padding:.7em 1em;border-left:4px solid #4a7fb5}
+@media (max-width:700px){body{padding:0 .5em;margin:1em auto}figure{margin:1em -.5em}
+figure img{width:100%;border-left:0;border-right:0}figcaption{padding:0 .5em}}
 @media print{pre{white-space:pre-wrap;overflow-wrap:anywhere}.scroll{overflow:visible}}
 """
 
@@ -787,9 +792,13 @@ def _table(headers: list[str], rows: list[list], table_id: str = "") -> str:
 
 
 def _img(name: str, png: bytes, caption: str) -> str:
+    """A figure embedded as PNG data, linked to its PNG file beside the report (``NAME.png``): a click opens it
+    full size, to be zoomed on a phone."""
     encoded = base64.b64encode(png).decode("ascii")
-    return (f'<figure id="fig-{name}"><img alt="{_e(caption)}" src="data:image/png;base64,{encoded}">'
-            f"<figcaption>{_e(caption)}</figcaption></figure>")
+    return (f'<figure id="fig-{name}"><a href="{name}.png" title="open the figure full size">'
+            f'<img alt="{_e(caption)}" src="data:image/png;base64,{encoded}"></a>'
+            f"<figcaption>{_e(caption)} <small>(click the figure to open it full size)</small></figcaption>"
+            "</figure>")
 
 
 def _fmt(value, digits: int = 4) -> str:
@@ -874,8 +883,7 @@ def verdict(data: dict) -> str:
     ok = lambda rows: sum(abs(r["relative_difference"]) <= REPRODUCED_WITHIN for r in rows)  # noqa: E731
     comparisons = data["comparisons"]
     passed = sum(c["passed"] for c in comparisons)
-    worst = max((x["relative_error"] for c in comparisons for x in c["checks"]
-                 if x.get("relative_error") is not None), default=None)
+    worst = largest_engine_error(comparisons)
     claims = [v for v in data.get("claims", []) if v.holds is not None]
     text = (f"{_count(ok(t2), len(t2))} maximum barrel displacements of Table 2"
             + (f" and {_count(ok(s22), len(s22))} first-impact numbers of Section 2.2" if s22 else "")
@@ -883,7 +891,8 @@ def verdict(data: dict) -> str:
     if claims:
         text += f"; {sum(v.holds for v in claims)} of the paper's {len(claims)} qualitative claims hold"
     text += (f". The engine agrees with the independent reference in {_count(passed, len(comparisons))} cases"
-             + (f" (largest relative error {worst:.1e})" if worst is not None else "") + ".")
+             + (f" (largest relative error {engine_error_text(worst[0])}: {worst[2]} of {worst[1]}, in the table "
+                "\u201cEngine vs independent reference\u201d)" if worst is not None else "") + ".")
     missed = [r for r in t2 if abs(r["relative_difference"]) > REPRODUCED_WITHIN]
     if missed:
         text += (" Not reproduced in Table 2: "
@@ -898,6 +907,39 @@ def verdict(data: dict) -> str:
     if failed:
         text += f" {len(failed)} of the claims do not hold."
     return text
+
+
+#: The engine-vs-reference table's columns: (check name of :func:`validation.studies.compare.compare_results`,
+#: short header); a check of another name (a scene with several contacts) gets a column of its own name.
+ENGINE_REFERENCE_COLUMNS = (("max_barrel_displacement", "x_max"), ("time_of_max_barrel_displacement", "t(x_max)"),
+                            ("peak_support_force", "peak support force"), ("peak_contact_force", "peak contact force"),
+                            ("max_absorber_velocity", "v_max absorber"),
+                            ("time_of_max_absorber_velocity", "t(v_max absorber)"),
+                            ("time_to_battery", "t(battery)"),
+                            ("barrel_position_history", "x_M(t)"), ("absorber_position_history", "x_m(t)"))
+
+
+def engine_reference_columns(comparisons: list[dict]) -> list[tuple[str, str]]:
+    """The (check name, header) columns of the engine-vs-reference table: every check any case has, those
+    of :data:`ENGINE_REFERENCE_COLUMNS` first, so that every number the verdict quotes is in a column."""
+    known = dict(ENGINE_REFERENCE_COLUMNS)
+    names = {x["name"] for c in comparisons for x in c["checks"]}
+    return ([(name, header) for name, header in ENGINE_REFERENCE_COLUMNS if name in names]
+            + [(name, name.replace("_", " ")) for name in sorted(names - set(known))])
+
+
+def engine_error_text(value: float | None) -> str:
+    """A relative error as the engine-vs-reference table and the verdict print it (two significant digits)."""
+    return "&ndash;" if value is None or not math.isfinite(value) else f"{value:.1e}"
+
+
+def largest_engine_error(comparisons: list[dict]) -> tuple[float, str, str] | None:
+    """The largest relative error of any check of any case, as (value, case, column header of the
+    engine-vs-reference table); None when no check has one."""
+    headers = dict(engine_reference_columns(comparisons))
+    found = [(x["relative_error"], c["scene"], headers[x["name"]]) for c in comparisons for x in c["checks"]
+             if x.get("relative_error") is not None]
+    return max(found, key=lambda item: item[0], default=None)
 
 
 def percent_text(fraction: float, digits: int = 1) -> str:
@@ -1052,27 +1094,28 @@ def render_html(data: dict, pngs: dict[str, bytes]) -> str:
     # engine vs reference
     parts.append(section("engine-vs-reference", "Engine vs independent reference, every case shown"))
     rows = []
+    columns = engine_reference_columns(data["comparisons"])
     for c in data["comparisons"]:
         err = {x["name"]: x["relative_error"] for x in c["checks"]}
-        rows.append([_e(c["scene"]), _fmt(err.get("max_barrel_displacement"), 2),
-                     _fmt(err.get("peak_contact_force"), 2), _fmt(err.get("max_absorber_velocity"), 2),
-                     _fmt(err.get("barrel_position_history"), 2), _fmt(err.get("absorber_position_history"), 2),
-                     f"{c['engine_impacts']} / {c['reference_impacts']}",
-                     "<span class='good'>pass</span>" if c["passed"] else "<span class='bad'>FAIL</span>"])
-    parts.append("<p>Relative errors; tolerances 1e-4 (displacement), 1e-3 (force, velocity, histories); the "
-                 "impact counts must be equal.</p>")
-    parts.append(_table(["case", "x_max", "peak force", "v_max absorber", "x_M(t)", "x_m(t)",
-                         "impacts engine / ref.", "verdict"], rows, table_id="tab-engine-vs-reference"))
+        rows.append([_e(c["scene"])] + [engine_error_text(err.get(name)) for name, _ in columns]
+                    + [f"{c['engine_impacts']} / {c['reference_impacts']}",
+                       "<span class='good'>pass</span>" if c["passed"] else "<span class='bad'>FAIL</span>"])
+    parts.append("<p>Relative errors of every compared quantity; tolerances 1e-4 (x_max), 1e-2 (t(v_max "
+                 "absorber)), 1e-3 (the others: times, forces, velocity, the histories x_M(t) and x_m(t) of the "
+                 "barrel and the absorber); the impact counts must be equal.</p>")
+    parts.append(_table(["case"] + [header for _, header in columns] + ["impacts engine / ref.", "verdict"], rows,
+                        table_id="tab-engine-vs-reference"))
     # conventions
     parts.append(section("conventions", "Convention study: readings of the paper"))
     parts.append("<p>Each reading of the paper alone, computed with the independent reference (the engine runs the "
-                 "same scenes; its largest relative difference from the reference is in the last column). The "
-                 "columns <i>model (i), 100 kg</i> to <i>model (ii), 1000 kg</i> give the maximum barrel displacement "
-                 "of Table 2 as (ours &minus; paper) / paper; <i>peak contact force</i> and <i>max absorber "
-                 "velocity</i> the same for Section 2.2 (model (i), m = 1000 kg); <i>RMS</i> is over those 6 Table 2 "
-                 "cells and the 6 Section 2.2 numbers; the three <i>gap</i> columns give model (ii)'s maximum barrel "
-                 "displacement at m = 1000 kg, which Fig. 5 says is largest at gap 0.</p>")
-    conv_rows = []
+                 "same scenes). The first table compares each reading with the paper: the columns <i>model (i), 100 "
+                 "kg</i> to <i>model (ii), 1000 kg</i> give the maximum barrel displacement of Table 2 as (ours "
+                 "&minus; paper) / paper; <i>peak contact force</i> and <i>max absorber velocity</i> the same for "
+                 "Section 2.2 (model (i), m = 1000 kg); <i>RMS</i> is over those 6 Table 2 cells and the 6 Section "
+                 "2.2 numbers. The second table gives model (ii)'s maximum barrel displacement at m = 1000 kg at "
+                 "three gaps (Fig. 5 says it is largest at gap 0) and the engine's largest relative difference from "
+                 "the reference over the reading's cases.</p>")
+    conv_rows, trend_rows = [], []
     for row in data["conventions"]:
         t2e = row.table2_errors()
         s2e = row.section22_errors()
@@ -1085,15 +1128,17 @@ def render_html(data: dict, pngs: dict[str, bytes]) -> str:
                           f"(option <code>{_e(row.label)}</code>)</small>"]
                          + [_pct(t2e[(m, mass)]) for m in (MODEL_I, MODEL_II) for mass in TABLE2_MASSES]
                          + [_pct(s2e[(MODEL_I, "peak_contact_force")]), _pct(s2e[(MODEL_I, "max_absorber_velocity")]),
-                            f"{row.rms_error() * 100:.1f}&nbsp;%"]
-                         + [f"{x * 1e3:.1f}" for x in row.trend()] + [engine_text])
+                            f"{row.rms_error() * 100:.1f}&nbsp;%"])
+        trend_rows.append([f"<b>{_e(reading_short(row.label))}</b>"] + [f"{x * 1e3:.1f}" for x in row.trend()]
+                          + [engine_text])
     not_run = ("<p class='note'>Not computed in this run (<code>recoil paper --reproduce-only</code>); "
                "<code>recoil paper</code> without that option computes it.</p>")
     if data["conventions"]:
         parts.append(_table(["reading"] + [f"{m}, {mass:g} kg" for m in (MODEL_I, MODEL_II) for mass in TABLE2_MASSES]
-                            + ["peak contact force, model (i)", "max absorber velocity, model (i)", "RMS"]
-                            + [f"gap {g * 1e3:g} mm [mm]" for g in TREND_GAPS] + ["engine vs reference, largest"],
+                            + ["peak contact force, model (i)", "max absorber velocity, model (i)", "RMS"],
                             conv_rows, table_id="tab-conventions"))
+        parts.append(_table(["reading"] + [f"gap {g * 1e3:g} mm [mm]" for g in TREND_GAPS]
+                            + ["engine vs reference, largest"], trend_rows, table_id="tab-conventions-trend"))
         same = coinciding_readings(data["conventions"])
         parts.append(_img("conventions_gap_trend", pngs["conventions_gap_trend"],
                           "Model (ii), m = 1000 kg: maximum barrel displacement vs gap under each reading"
@@ -1192,7 +1237,7 @@ def results_json(data: dict) -> dict:
 
 def write_report(out: str | Path, options: ReportOptions = ReportOptions(), progress: Progress = _silent) -> dict:
     """Compute everything and write ``report.html``, ``results.json``, ``table2.md/json`` and PNGs to ``out``."""
-    out = prepare_output_dir(out)
+    check_output_dir(out)   # a bad directory: SceneError before any work; created once there is something to write
     start = time.perf_counter()
     data = compute_report(options, progress)
     progress("figures and report")
@@ -1201,6 +1246,7 @@ def write_report(out: str | Path, options: ReportOptions = ReportOptions(), prog
     pngs = make_figures(data, options.workers)
     data["timings"]["figures (wall)"] = time.perf_counter() - figures_start
     from mbs_models.outputs import atomic_write_bytes
+    out = prepare_output_dir(out)
     for name, png in pngs.items():
         atomic_write_bytes(out / f"{name}.png", png)
     rows = table2_rows(data)

@@ -285,3 +285,16 @@ def test_an_initial_interference_approached_at_t0_is_an_impact():
     first = r.contacts["contact"].episodes[0]
     assert first.start == 0.0 and first.peak_force - static > 10000.0
     assert r.impacts[0] == first
+
+
+def test_a_single_shot_returns_to_battery_as_the_closed_form_says():
+    """``time_to_battery`` against the simplified model's closed form (tests/battery_return.py); the reference's
+    tolerances (rtol 1e-10) leave its error near 1e-9, 1e-7 is a margin for any machine."""
+    from battery_return import simplified_return
+
+    scene = simplified_model()
+    _, x_max, t_back = simplified_return(scene)
+    reference = solve_reference(scene, 5.0)
+    assert reference.max_barrel_displacement == pytest.approx(x_max, rel=1e-7)
+    assert reference.time_to_battery == pytest.approx(t_back, rel=1e-7)
+    assert solve_reference(scene, 1.5).time_to_battery is None     # not back yet

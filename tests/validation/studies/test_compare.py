@@ -103,7 +103,7 @@ class _PlanarEngine:
         self.velocities = {b: reference.velocity(b, self.time) for b in reference.bodies}
         self.contacts = {}
         for name in ("max_barrel_displacement", "time_of_max_barrel_displacement", "peak_support_force",
-                     "peak_contact_force", "max_absorber_velocity", "time_of_max_absorber_velocity"):
+                     "peak_contact_force", "max_absorber_velocity", "time_of_max_absorber_velocity", "time_to_battery"):
             setattr(self, name, getattr(reference, name))
         self._metrics = reference.metrics() if metrics else {}
         self.supports = reference.supports() if supports else None

@@ -239,7 +239,7 @@ def page_problems(html_text: str) -> list[str]:
 
 @pytest.fixture(scope="module")
 def report_dir(tmp_path_factory):
-    out = tmp_path_factory.mktemp("report")
+    out = tmp_path_factory.mktemp("report") / "new" / "directory"   # missing directories are created
     write_report(out, ReportOptions.reduced())
     return out
 
@@ -252,8 +252,8 @@ def test_report_html_has_every_section_figure_and_table(report_dir):
     for section in ("models", "parameters", "table2", "sweeps", "histories", "contact", "engine-vs-reference",
                     "conventions", "calibration", "claims", "unreproduced", "carriage", "cost"):
         assert section in ids, section
-    for table in ("parameters", "table2", "section22", "engine-vs-reference", "conventions", "calibration-table2",
-                  "claims", "carriage"):
+    for table in ("parameters", "table2", "section22", "engine-vs-reference", "conventions", "conventions-trend",
+                  "calibration-table2", "claims", "carriage"):
         assert f"tab-{table}" in ids, table
     expected_figures = {"fig4_gap_sweep_model_i", "fig5_gap_sweep_model_ii", "conventions_gap_trend",
                         "support_force_m1000", "energy_m1000", "carriage_ground_reactions"} | {
@@ -522,6 +522,42 @@ def test_the_verdict_counts_what_table2_shows(report_dir):
     assert f"in {sum(c['passed'] for c in comparisons)} of {len(comparisons)} cases" in summary, summary
 
 
+def test_the_verdicts_largest_error_is_a_cell_of_the_engine_vs_reference_table(report_dir):
+    """The headline's "largest relative error" names a case and a quantity, and that row and column of the
+    table hold the same number -- the largest of every number in the table's error columns."""
+    text = (report_dir / "report.html").read_text()
+    summary = html.unescape(re.sub(r"<[^>]*>", "", re.search(r"<p id='summary'>(.*?)</p>", text, re.DOTALL).group(1)))
+    found = re.search(r"largest relative error (\S+): (.+?) of (.+?), in the table", summary)
+    assert found, summary
+    value, quantity, case = found.groups()
+    page = _Page()
+    page.feed(text)
+    table = next(t for t in page.tables if t["section"] == "engine-vs-reference")
+    [row] = [r for r in table["rows"] if r[0] == case]
+    assert row[table["headers"].index(quantity)] == value
+    errors = [float(cell) for r in table["rows"] for cell in r[1:table["headers"].index("impacts engine / ref.")]
+              if re.fullmatch(r"\d\.\de[+-]\d\d", cell)]
+    assert float(value) == max(errors)
+    # and it is the largest relative error of any check in results.json
+    comparisons = json.loads((report_dir / "results.json").read_text())["engine_vs_reference"]
+    largest = max(x["relative_error"] for c in comparisons for x in c["checks"] if x["relative_error"] is not None)
+    assert f"{largest:.1e}" == value
+
+
+def test_every_figure_opens_full_size_and_fills_a_narrow_screen(report_dir):
+    text = (report_dir / "report.html").read_text()
+    figures = re.findall(r"<figure id=\"fig-([^\"]+)\">(.*?)</figure>", text, re.DOTALL)
+    assert len(figures) >= 10
+    for name, body in figures:
+        link = re.match(r'<a href="([^"]+)"[^>]*><img ', body)
+        assert link, f"figure {name} is not a link"
+        assert (report_dir / link.group(1)).read_bytes()[:8] == PNG_SIGNATURE   # the PNG written beside it
+        assert link.group(1) == f"{name}.png"
+    narrow = re.search(r"@media \(max-width:(\d+)px\)\{(.*?\})\}", text, re.DOTALL)
+    assert narrow and int(narrow.group(1)) >= 390, "no style for a narrow screen"
+    assert re.search(r"figure img\{width:100%", narrow.group(2)) and re.search(r"figure\{margin:[^}]*-", narrow.group(2))
+
+
 # ------------------------------------------------------------------------------------- convention study
 def _reading(label: str, trend_mm: tuple[float, float, float]):
     from mbs_models import Conventions
@@ -565,13 +601,16 @@ def test_every_reading_has_plain_words():
 def test_convention_table_one_number_per_cell_with_units(report_dir):
     page = _Page()
     page.feed((report_dir / "report.html").read_text())
-    table = next(t for t in page.tables if t["section"] == "conventions")
+    table, trend = [t for t in page.tables if t["section"] == "conventions"]
     for model in ("model (i)", "model (ii)"):
         for mass in ("100", "500", "1000"):
             assert f"{model}, {mass} kg" in table["headers"], table["headers"]
     for gap in ("0", "40", "80"):
-        column = table["headers"].index(f"gap {gap} mm [mm]")
-        assert all(re.fullmatch(r"\d+\.\d", row[column]) for row in table["rows"]), [r[column] for r in table["rows"]]
+        column = trend["headers"].index(f"gap {gap} mm [mm]")
+        assert all(re.fullmatch(r"\d+\.\d", row[column]) for row in trend["rows"]), [r[column] for r in trend["rows"]]
+    # the same readings, in the same order, in both tables (the second names each by its short name)
+    assert [row[0] for row in trend["rows"]] == [row[0][:len(trend_row[0])] for row, trend_row in
+                                                  zip(table["rows"], trend["rows"])]
 
 
 # ------------------------------------------------------------------------------- what we cannot reproduce

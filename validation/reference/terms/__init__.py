@@ -12,7 +12,7 @@ adding one module here; a user's element defined outside the package registers i
 :func:`register_term`.
 
 Modules without ``TABLES`` are building blocks of the terms (:mod:`.contact_laws`, :mod:`.spring_damper`).
-The terms are found by the table names they declare (:data:`TERMS`, below), never listed here: the README
+The terms are found by the table names they declare (:data:`TERMS`, below), never listed here: the user guide
 lists the effects and their tables, and ``tests/validation/reference/test_terms.py`` checks that every scene
 table has a term.
 """
