@@ -120,8 +120,9 @@ CHATTERING = model_ii(1.0, 0.0).with_changes(**{
 #: undamped stay within the guarantee.  The stated exception (validation.studies.guarantee.LIGHT_UNDAMPED_BOUNDS;
 #: docs/validation/checks.md), pinned below on the scan's worst scenes.
 STIFF_CHATTER = CHATTERING.with_changes(**{"contact.stiffness": 1e10, "contact.exponent": 2.0})
+#: (STIFF_CHATTER itself meets the guarantee since issue #24's maximum steps: the scan at those steps, the same 45
+#: scenes, found the same worst errors, 4.8e-4 / 4.9e-4 / 3.6e-4 s / 5.0e-5, and every scene within the stated bounds.)
 LIGHT_UNDAMPED_WORST = {
-    "k1e10-n2-v100": STIFF_CHATTER,
     "k1e12-n1.5-v56": CHATTERING.with_changes(**{"contact.stiffness": 1e12, "firing.muzzle_velocity": 56.4}),
     "k1e10-n1.5-v564": CHATTERING.with_changes(**{"contact.stiffness": 1e10, "firing.muzzle_velocity": 564.0}),
     "damped-recoil-k1e12-n1.5-v564": model_ii(1.0, 0.0).with_changes(**{

@@ -37,6 +37,13 @@ TOLERANCES = {
 #: ``tests/test_properties.py`` leaves the region out of the random scenes and pins the grid's worst scenes.
 LIGHT_UNDAMPED_MASS = 10.0
 LIGHT_UNDAMPED_BOUNDS = {"standard": {"metric": 1e-4, "force": 1e-3, "impact_peak": 1e-3, "time": 5e-4}}
+#: A measured residual: a hydraulic brake (the quadratic orifice law) at ``reference``.  The shipped realistic scene
+#: without cradle friction keeps its trajectory within the guarantee (displacement error below 7e-9) but its energy
+#: balance scatters between 1.5e-9 and 8.5e-9 of the initial energy when its designed orifice table moves by 1e-8 to
+#: 1e-5 relative (DOPRI5's error at rtol 1e-11 during the braked recoil: 3.6e-10 at rtol 1e-12, 1.1e-9 with a 1 ms
+#: max step), against the 5e-9 of :data:`TOLERANCES`.  Such a scene is held to these bounds at ``reference``
+#: (``tests/test_realistic_scene.py``; docs/validation/checks.md).
+BRAKE_REFERENCE_BOUNDS = {"reference": {"energy": 1e-8}}
 
 
 def light_undamped_absorber(scene) -> bool:
