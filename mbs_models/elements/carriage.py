@@ -56,7 +56,7 @@ import numpy as np
 
 from ..errors import SceneError
 from .contact_laws import LAW_FIELDS, LAW_KEY_UNITS, LAW_RULES, LawFields, OnsetCapture, law_force
-from .ops import Ops
+from .ops import Ops, SymbolicVariables
 from .table import Rule, Table, check_choice, check_derived, check_number, ieee_power
 
 #: Default regularisation velocity of a support's Coulomb friction (m/s), as the cradle's.
@@ -324,7 +324,7 @@ def onset_capture(support: Support, static_load: float) -> OnsetCapture | None:
     return capture
 
 
-class AnchorCapture:
+class AnchorCapture(SymbolicVariables):
     """A ``touchdown`` spade's anchor (m), captured at the step starts of a solve: while the point is off the
     ground (``height >= 0``) the anchor follows its x, so that it stays where the point last touched down (to
     within the point's horizontal travel in the step that lands).  :attr:`history` holds ``(time, anchor)`` at

@@ -52,7 +52,7 @@ import numpy as np
 
 from ..errors import SceneError
 from .connector import Connector
-from .ops import NUMPY_OPS, PYTHON_OPS, Ops
+from .ops import NUMPY_OPS, PYTHON_OPS, Ops, SymbolicVariables
 from .table import Rule, Table, check_choice, check_derived
 
 #: Restitution-law impacts slower than this (m/s) are damped as if they came at this speed.
@@ -296,7 +296,7 @@ def _first_root(a: float, b: float, c: float, upper: float) -> float:
     return min(-c / b, upper) if b > 0.0 else 0.0
 
 
-class OnsetCapture:
+class OnsetCapture(SymbolicVariables):
     """The penetration rate at the onset of each contact episode, captured at the step starts of a solve.
 
     :meth:`observe` is called with the state at the start of every step (Exudyn's pre-step function).

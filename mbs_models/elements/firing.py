@@ -46,7 +46,7 @@ from ..inputs import read_two_columns
 from .barrel import BARREL
 from .connector import Load
 from .declaration import Metric, Outputs
-from .ops import LinearPieces, NumpyPiecewiseLinear, Ops, piecewise_linear
+from .ops import LinearPieces, NumpyPiecewiseLinear, Ops, SymbolicVariables, piecewise_linear
 from .table import Rule, Table, check_derived, check_number
 
 #: The directory that relative file names in a scene (``firing.pulse.file``) resolve against: the
@@ -295,7 +295,7 @@ class Firing(Table):
                                                              for s in shots])]
 
 
-class BreechForce(Load):
+class BreechForce(SymbolicVariables, Load):
     """The breech force ``F(t)`` on the barrel (N): piecewise linear through ``points``, 0 outside.
 
     The solve is split at every point (:attr:`breakpoints`), and in each segment the solver evaluates the
@@ -305,6 +305,7 @@ class BreechForce(Load):
     """
 
     needs_user_function = True
+    SYMBOLIC = ("_variables",)
 
     def __init__(self, element: str, points: list[tuple[float, float]], windows: list[tuple[float, float]]):
         super().__init__("breech_force", element, BARREL)

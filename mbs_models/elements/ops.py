@@ -90,6 +90,19 @@ def piecewise_linear(x, points, ops: Ops):
     return ops.select(x < xs[0], ys[0], result)
 
 
+class SymbolicVariables:
+    """A mixin for the objects that hold Exudyn symbolic variables while a solve runs (``SYMBOLIC``: the names
+    of those attributes): a copy or pickle holds None there, the numbers kept (a Result keeps its solve's laws
+    for the forces between the samples, :mod:`mbs_models.results.dense`, and crosses process boundaries)."""
+
+    SYMBOLIC: tuple[str, ...] = ("_variable",)
+
+    def __getstate__(self):
+        state = dict(self.__dict__)
+        state.update({name: None for name in self.SYMBOLIC})
+        return state
+
+
 class LinearPieces:
     """The linear pieces of :func:`piecewise_linear` through ``points``, for a solver that integrates one piece
     at a time.

@@ -80,7 +80,7 @@ def build_result(record: RunRecord) -> Result:
                   rest_tolerance=record.rest_tolerance, steps=record.steps, wall_time=t_end - record.wall_started,
                   timings={"assembly": record.assembled - record.started, "solve": record.solved - record.assembled,
                            "postprocess": t_end - record.solved},
-                  **fields)
+                  samples=samples, mechanism=mechanism, **fields)
 
 
 def _largest(candidates) -> tuple[float | None, float | None]:

@@ -137,7 +137,7 @@ class PlanarGeometry:
         return out
 
 
-def _coordinate_samples(s: Samples) -> Samples:
+def coordinate_samples(s: Samples) -> Samples:
     """The carriage's three coordinates as Samples (for their Hermite interpolation)."""
     return Samples(time=s.time, positions={k: s.planar[f"{k}_position"] for k in _COORDINATES},
                    velocities={k: s.planar[f"{k}_velocity"] for k in _COORDINATES},
@@ -187,7 +187,7 @@ def carriage_output(mechanism, s: Samples, interp: Interpolant, energies=None) -
         loads = ", ".join(f"{o.name} {o.static_normal_force:.3g} N" for o in supports.values())
         raise SimulationError(f"the stability margin (least load / static load) is beyond double precision: the "
                               f"static loads ({loads}) are too small against the loads of the run")
-    coordinates = Interpolant(_coordinate_samples(s))
+    coordinates = Interpolant(coordinate_samples(s))
 
     def refined(sampled: np.ndarray, of_time) -> float:
         """The largest |value| of a sampled quantity, refined near its largest sample on ``of_time(t)`` (the same
@@ -217,7 +217,7 @@ def _planar_energies(mechanism, geometry, static, s, interp, q, v, supports, ene
     """Make the 1-D energies of a carriage scene planar, in place (:func:`carriage_output`)."""
     t = s.time
     nodes_t = t[:-1] + _GL_NODES[:, None] * np.diff(t)
-    coordinates = Interpolant(_coordinate_samples(s))
+    coordinates = Interpolant(coordinate_samples(s))
     cq, cv = coordinates.at_fractions(_GL_NODES)
     bq, bv = interp.at_fractions(_GL_NODES)
     qn, vn = {**cq, **bq}, {**cv, **bv}

@@ -28,6 +28,22 @@ def compute(mechanism, samples, interpolant) -> tuple[dict[str, dict[str, np.nda
     scene on the samples (a history as a float array, one value per sample)."""
     histories: dict[str, dict[str, np.ndarray]] = {}
     metrics: dict[str, dict[str, Any]] = {}
+    for name, run, outputs in _runs(mechanism, samples, interpolant):
+        if run.histories:
+            histories[name] = run.histories
+        if outputs.metrics:
+            metrics[name] = {metric.name: _plain(metric.compute(run)) for metric in outputs.metrics}
+    return histories, metrics
+
+
+def compute_histories(mechanism, samples, interpolant) -> dict[str, dict[str, np.ndarray]]:
+    """The declared histories alone, ``{element: {name: array}}``, on ``samples`` (any times: the densified
+    output's, :mod:`mbs_models.results.dense`); ``interpolant`` gives the state between them."""
+    return {name: run.histories for name, run, _ in _runs(mechanism, samples, interpolant) if run.histories}
+
+
+def _runs(mechanism, samples, interpolant):
+    """``(element name, ElementRun with its histories computed, outputs)`` of every declaring element, in order."""
     for name, table, outputs in declared(mechanism.scene):
         own: dict[str, np.ndarray] = {}
         run = ElementRun(table, name, mechanism.scene, mechanism, samples, interpolant, own)
@@ -37,11 +53,7 @@ def compute(mechanism, samples, interpolant) -> tuple[dict[str, dict[str, np.nda
                 raise ValueError(f"{name}.{history.name}: the history has shape {values.shape}, the run's time "
                                  f"{samples.time.shape}")
             own[history.name] = values
-        if own:
-            histories[name] = own
-        if outputs.metrics:
-            metrics[name] = {metric.name: _plain(metric.compute(run)) for metric in outputs.metrics}
-    return histories, metrics
+        yield name, run, outputs
 
 
 def _plain(value):

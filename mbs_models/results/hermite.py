@@ -5,7 +5,12 @@ dy is interpolated as
 
     y(t) = (2 s^3 - 3 s^2 + 1) y0 + (s^3 - 2 s^2 + s) h dy0 + (-2 s^3 + 3 s^2) y1 + (s^3 - s^2) h dy1,
 
-which is fourth-order accurate in h (position from velocity, velocity from acceleration).  The basis
+which is fourth-order accurate in h (position from velocity, velocity from acceleration); its derivative
+
+    y'(t) = 6 (s^2 - s) (y0 - y1) / h + (3 s^2 - 4 s + 1) dy0 + (3 s^2 - 2 s) dy1
+
+(:meth:`HermiteStack.derivative`: an acceleration between samples from the velocity's interpolant) is
+third-order accurate, dy0 and dy1 at the ends.  The basis
 polynomials depend only on t, so :class:`HermiteStack` computes them once for all the quantities
 sampled at the same times (every body's position and velocity) and evaluates each quantity with the
 same floating-point operations, in the same order, as :func:`hermite` does for one.
@@ -33,6 +38,14 @@ def _basis(t0, t1, t):
     s = (t - t0) / h
     s2, s3 = s * s, s * s * s
     return 2 * s3 - 3 * s2 + 1, (s3 - 2 * s2 + s) * h, -2 * s3 + 3 * s2, (s3 - s2) * h
+
+
+def _derivative_basis(t0, t1, t):
+    """The four basis polynomials of the derivative of :func:`hermite` at ``t``, in :func:`_apply`'s order."""
+    h = t1 - t0
+    s = (t - t0) / h
+    s2 = s * s
+    return 6 * (s2 - s) / h, 3 * s2 - 4 * s + 1, 6 * (s - s2) / h, 3 * s2 - 2 * s
 
 
 def _apply(basis, y0, y1, dy0, dy1):
@@ -81,6 +94,10 @@ class HermiteStack:
         self._derivatives = slice(first_derivative, first_derivative + count)
         self.time, self.y, self.dy = table[0], table[self._values], table[self._derivatives]
 
+    def _interval(self, t: np.ndarray) -> np.ndarray:
+        """The index of the sample interval holding each time (bisection; the first or last beyond the ends)."""
+        return np.minimum(np.maximum(np.searchsorted(self.time, t, side="right") - 1, 0), len(self.time) - 2)
+
     def __call__(self, t, quantities=None) -> np.ndarray:
         """Values at times ``t`` (s, any shape), the interval of each found by bisection.
 
@@ -88,7 +105,7 @@ class HermiteStack:
         the same floats as in the full result; None: all of them.  Only the samples of those quantities are
         gathered, so a call for a few quantities of a large stack costs what those few cost."""
         t = np.asarray(t, dtype=float)
-        i = np.minimum(np.maximum(np.searchsorted(self.time, t, side="right") - 1, 0), len(self.time) - 2)
+        i = self._interval(t)
         if quantities is None:
             # take: the same gathers as indexing, several times faster along axis 1
             before, after = self._table.take(i, axis=1), self._table.take(i + 1, axis=1)
@@ -101,6 +118,16 @@ class HermiteStack:
             values, derivatives = slice(1, 1 + len(wanted)), slice(1 + len(wanted), 1 + 2 * len(wanted))
         return _combine(before[0], after[0], t, before[values], after[values], before[derivatives],
                         after[derivatives])
+
+    def derivative(self, t, quantities=None) -> np.ndarray:
+        """The interpolants' time derivatives at times ``t`` (s, any shape; module docstring), shaped as
+        :meth:`__call__`'s values; at a sample time, the sampled derivative of the interval after it."""
+        t = np.asarray(t, dtype=float)
+        i = self._interval(t)
+        count = self._values.stop - self._values.start
+        wanted = np.arange(count) if quantities is None else np.asarray(quantities, dtype=np.intp)
+        y, dy = self._table[self._values.start + wanted], self._table[self._derivatives.start + wanted]
+        return _apply(_derivative_basis(self.time[i], self.time[i + 1], t), y[:, i], y[:, i + 1], dy[:, i], dy[:, i + 1])
 
     def at_fractions(self, fractions: np.ndarray) -> np.ndarray:
         """Values at ``t_i + f h_i`` for every fraction f and interval i: shape (Q, fractions, intervals).

@@ -8,6 +8,11 @@ force and the force on the mount (N, positive in the recoil direction); on a car
 (``<element> <name> [<unit>]``, :mod:`mbs_models.elements.declaration`); the energies (J): kinetic per body,
 stored and dissipated per connector, the work of every external input, their totals and the
 energy-balance error (:meth:`Result.energy_error`).
+
+Rows: by default the densified histories (:mod:`mbs_models.results.dense`: the step-end samples and, in every
+step longer than 1 ms, times no more than 1 ms apart on the interpolant and the laws); ``interval`` (s) sets that
+gap, ``step_ends=True`` writes the solver's step-end samples alone (``recoil run --history-interval S``,
+``--step-ends``).  The columns are the same either way.
 """
 
 from __future__ import annotations
@@ -20,11 +25,13 @@ import numpy as np
 
 from ..outputs import atomic_write_text
 from . import element_outputs
+from .dense import output_histories
 from .result import Result
 
 
 def history_columns(result: Result) -> dict[str, np.ndarray]:
-    """The table's columns in order: ``{"<what> [<unit>]": values at result.time}`` (module docstring)."""
+    """The table's columns in order: ``{"<what> [<unit>]": values at result.time}`` (module docstring), of the
+    Result as it is (a densified one's rows are dense)."""
     columns: dict[str, np.ndarray] = {"time [s]": result.time}
     for name in result.positions:
         columns[f"{name} position [m]"] = result.positions[name]
@@ -65,10 +72,11 @@ def history_columns(result: Result) -> dict[str, np.ndarray]:
     return columns
 
 
-def histories_csv(result: Result) -> str:
-    """The table as CSV text: a header row of column names with units, then one row per output time
-    (numbers written exactly: Python's shortest round-trip representation)."""
-    columns = history_columns(result)
+def histories_csv(result: Result, interval: float | None = None, step_ends: bool = False) -> str:
+    """The table as CSV text: a header row of column names with units, then one row per output time -- the
+    densified histories' at ``interval`` (s; None: the default), the step-end samples' with ``step_ends`` (module
+    docstring) -- (numbers written exactly: Python's shortest round-trip representation)."""
+    columns = history_columns(output_histories(result, interval, step_ends))
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
     writer.writerow(columns)
@@ -76,6 +84,8 @@ def histories_csv(result: Result) -> str:
     return buffer.getvalue()
 
 
-def write_histories_csv(result: Result, path: str | Path) -> Path:
-    """Write :func:`histories_csv` to ``path`` atomically (temporary name, then rename)."""
-    return atomic_write_text(path, histories_csv(result))
+def write_histories_csv(result: Result, path: str | Path, interval: float | None = None,
+                        step_ends: bool = False) -> Path:
+    """Write :func:`histories_csv` (``interval`` s, ``step_ends``) to ``path`` atomically (temporary name, then
+    rename)."""
+    return atomic_write_text(path, histories_csv(result, interval, step_ends))

@@ -1,5 +1,10 @@
 """Engineering plots of results: units on axes, legends, readable at 100 %.
 
+Every plot of time histories draws the densified histories (:mod:`mbs_models.results.dense`: the step-end
+samples and, in longer steps, times no more than ``interval`` s apart on the interpolant and the laws; 1 ms by
+default, :func:`~mbs_models.results.dense.default_interval`) -- no straight chords across the solver's 20 ms
+steps; ``step_ends=True`` draws the step-end samples alone.
+
 Uses matplotlib's object-oriented API (``Figure`` + Agg canvas): no global pyplot state and no
 display needed, so it is safe in scripts, tests and worker processes.
 """
@@ -17,6 +22,7 @@ from matplotlib.figure import Figure
 from ..errors import SceneError
 from ..outputs import atomic_write_bytes
 from . import element_outputs
+from .dense import output_histories
 from .carriage_plots import carriage_rows, plot_ground_reactions, sketch_gun
 from .result import Result
 
@@ -78,12 +84,15 @@ def _series_colour(i: int) -> str:
     return SERIES_COLOURS[i % len(SERIES_COLOURS)]
 
 
-def plot_result(result: Result, *, title: str | None = None, impact_padding: float = 0.25) -> Figure:
+def plot_result(result: Result, *, title: str | None = None, impact_padding: float = 0.25,
+                interval: float | None = None, step_ends: bool = False) -> Figure:
     """Time histories of one run: positions; contact forces (one line per contact); the force on the
     mount; velocities; and, with an impact, a zoom on the first one (its contact's force and the force on
     the mount over the impact's duration plus ``impact_padding`` of it either side, time in ms).  Every
     body and contact the scene has, none it lacks; after the velocities, a panel per ``panel`` of the histories
-    elements declare (:func:`~mbs_models.results.element_outputs.plot_panels`)."""
+    elements declare (:func:`~mbs_models.results.element_outputs.plot_panels`).  Histories densified at
+    ``interval`` (s; None: the default), or the step-end samples with ``step_ends`` (module docstring)."""
+    result = output_histories(result, interval, step_ends)
     contacts = list(result.contacts.values())
     first_impact = result.impacts[0] if result.impacts else None
     declared = element_outputs.plot_panels(result)
@@ -164,11 +173,13 @@ def _plot_impact_zoom(ax, result: Result, impact, padding: float) -> None:
     ax.legend(fontsize=8, loc="upper right")
 
 
-def plot_barrel_displacements(results: Sequence[Result], *, title: str) -> Figure:
-    """Barrel displacement of several models over time, as the paper's Figs 6-8."""
+def plot_barrel_displacements(results: Sequence[Result], *, title: str,
+                              interval: float | None = None, step_ends: bool = False) -> Figure:
+    """Barrel displacement of several models over time, as the paper's Figs 6-8 (histories densified at
+    ``interval``, s, or the step-end samples with ``step_ends``)."""
     fig, axes = new_figure(1, 1, row_height=3.6)
     ax = axes[0, 0]
-    for result in results:
+    for result in (output_histories(r, interval, step_ends) for r in results):
         colour = MODEL_COLOURS.get(result.scene.model_label)
         ax.plot(result.time, result.barrel_position * 1e3, color=colour,
                 label=f"{result.scene.model_label}: max {result.max_barrel_displacement * 1e3:.1f} mm")
@@ -186,19 +197,21 @@ PAPER_ZOOM_WINDOWS = {"model (i)": 3.25, "model (ii)": 1.15}
 
 
 def plot_contact_histories(results: Sequence[Result], quantity: str, *, title: str,
-                           zoom_windows: dict[str, float] | None = None) -> Figure:
+                           zoom_windows: dict[str, float] | None = None,
+                           interval: float | None = None, step_ends: bool = False) -> Figure:
     """Contact force or absorber velocity of models (i) and (ii), full run and zoom (Figs 9-10).
 
     ``quantity`` is ``"contact_force"`` (kN) or ``"absorber_velocity"`` (m/s).  With zoom windows,
     ``zoom_windows`` maps a model label to a window (s): the right-hand panels then show the first
-    seconds of that model's run (the main effective impacts; the paper's windows by default).
+    seconds of that model's run (the main effective impacts; the paper's windows by default).  Histories
+    densified at ``interval`` (s), or the step-end samples with ``step_ends``.
     """
     scale, label = (1e-3, "contact force $F_{ct}$ [kN]") if quantity == "contact_force" else \
         (1.0, "absorber velocity $\\dot x_m$ [m/s]")
     zoom_windows = PAPER_ZOOM_WINDOWS if zoom_windows is None else zoom_windows
     cols = 2 if zoom_windows else 1
     fig, axes = new_figure(len(results), cols, width=10.0 if cols == 2 else 8.0, row_height=2.8)
-    for row, result in enumerate(results):
+    for row, result in enumerate(output_histories(r, interval, step_ends) for r in results):
         values = getattr(result, quantity) * scale
         colour = MODEL_COLOURS.get(result.scene.model_label)
         zoom_window = zoom_windows.get(result.scene.model_label, 1.0) if zoom_windows else None
@@ -226,10 +239,12 @@ def plot_contact_histories(results: Sequence[Result], quantity: str, *, title: s
     return fig
 
 
-def plot_first_impact(results: Sequence[Result], *, title: str, padding: float = 0.25) -> Figure:
-    """Contact force over the first impact of each model, zoomed to its duration (Fig. 11)."""
+def plot_first_impact(results: Sequence[Result], *, title: str, padding: float = 0.25,
+                      interval: float | None = None, step_ends: bool = False) -> Figure:
+    """Contact force over the first impact of each model, zoomed to its duration (Fig. 11; histories densified at
+    ``interval``, s, or the step-end samples with ``step_ends``)."""
     fig, axes = new_figure(1, len(results), width=5.0 * len(results), row_height=3.4)
-    for col, result in enumerate(results):
+    for col, result in enumerate(output_histories(r, interval, step_ends) for r in results):
         ax = axes[0, col]
         colour = MODEL_COLOURS.get(result.scene.model_label)
         if not result.impacts:

@@ -106,6 +106,12 @@ class Result:
     says why the run ended, ``stop_reason.message`` in words.  A Result is immutable: it is built once, from
     everything the run collected (:mod:`mbs_models.engine.result_builder`); assigning to an attribute raises
     ``dataclasses.FrozenInstanceError``.
+
+    Step ends and dense histories: the histories are the solver's step-end samples (``samples``, a
+    :class:`~mbs_models.results.samples.Samples`; ``mechanism``: the solve's bodies and connectors, whose laws
+    give the forces between them).  :meth:`densified` gives the same run with its histories on a fine grid (the
+    plots' and ``--csv``'s, :mod:`mbs_models.results.dense`); its ``step_ends`` is the Result of the step-end
+    samples (None on a Result of step-end samples), and every metric is that Result's.
     """
 
     scene: Any
@@ -145,6 +151,9 @@ class Result:
     rest_time: float | None = None
     rest_tolerance: float | None = None
     carriage: Any = field(repr=False, default=None)
+    samples: Any = field(repr=False, default=None, compare=False)
+    mechanism: Any = field(repr=False, default=None, compare=False)
+    step_ends: "Result | None" = field(repr=False, default=None, compare=False)
 
     def __getattr__(self, name: str):
         """A carriage metric (``result.stability_margin``, ... :data:`~mbs_models.results.carriage.CARRIAGE_METRICS`;
@@ -176,11 +185,24 @@ class Result:
         sample time, the sample itself.  Raises ``ValueError`` for a time outside the histories."""
         from .samples import Interpolant, Samples
 
+        base = self.step_ends if self.step_ends is not None else self  # a densified Result: its step-end samples
         t = np.asarray(t, dtype=float)
-        if t.size and not (np.min(t) >= self.time[0] and np.max(t) <= self.time[-1]):
-            raise ValueError(f"state_at: times must lie in [{self.time[0]:g}, {self.time[-1]:g}] s (the histories), "
+        if t.size and not (np.min(t) >= base.time[0] and np.max(t) <= base.time[-1]):
+            raise ValueError(f"state_at: times must lie in [{base.time[0]:g}, {base.time[-1]:g}] s (the histories), "
                              f"got [{np.min(t):g}, {np.max(t):g}] s")
-        return Interpolant(Samples(self.time, self.positions, self.velocities, self.accelerations)).state(t)
+        return Interpolant(Samples(base.time, base.positions, base.velocities, base.accelerations)).state(t)
+
+    def densified(self, interval: float | None = None) -> "Result":
+        """The same run with every history on a fine time grid: the step-end samples and, in each step longer
+        than ``interval`` (s, 1e-5 to 1; None: 1 ms, finer for a window under 2 s, coarser beyond 1000 s,
+        :func:`~mbs_models.results.dense.default_interval`), equally spaced times no more than ``interval`` apart,
+        where positions and velocities are the cubic Hermite interpolant of :meth:`state_at`, accelerations its
+        velocity's derivative, and forces and energies the same laws as at the samples
+        (:func:`mbs_models.results.dense.densify`).  Every metric is this Result's; the plots and ``recoil run
+        --csv`` use it.  SceneError naming ``interval`` outside its range."""
+        from .dense import densify
+
+        return densify(self, interval)
 
     # ------------------------------------------------------------------ version-1 shortcuts
     @property
@@ -339,7 +361,8 @@ class Result:
         if getattr(self.scene, "burst", None) is not None or self.max_barrel_displacement is None \
                 or self.max_at_end_of_window:
             return None
-        return return_to_battery(self.time, self.barrel_position, self.barrel_velocity,
+        base = self.step_ends if self.step_ends is not None else self  # found on the step-end samples
+        return return_to_battery(base.time, base.barrel_position, base.barrel_velocity,
                                  self.time_of_max_barrel_displacement, self.max_barrel_displacement)
 
     def maxima_at_end_of_window(self) -> list[str]:

@@ -73,6 +73,13 @@ class Interpolant:
         return ({name: values[j] for j, name in enumerate(bodies)},
                 {name: values[len(index) + j] for j, name in enumerate(bodies)})
 
+    def accelerations(self, t) -> dict:
+        """Every body's acceleration (m/s^2) at times ``t`` (s, any shape): the derivative of its velocity's
+        interpolant (:meth:`~mbs_models.results.hermite.HermiteStack.derivative`; the sample at a sample time)."""
+        n = len(self.names)
+        values = self._stack.derivative(t, list(range(n, 2 * n)))
+        return {name: values[i] for i, name in enumerate(self.names)}
+
     def at_fractions(self, fractions) -> tuple[dict, dict]:
         """Every body's position and velocity at ``t_i + f h_i``, shape (fractions, intervals) each."""
         return self._split(self._stack.at_fractions(fractions))

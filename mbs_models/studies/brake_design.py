@@ -296,8 +296,10 @@ def compare_with_linear_damper(scene: Scene, recoil_length: float, accuracy: str
 
 
 def plot_comparison(comparison: Comparison):
-    """Resistance vs stroke of the designed brake and the linear damper (peak support force in the legend).  A
-    matplotlib ``Figure`` of its own (no pyplot state: nothing is left open, the caller's backend unchanged)."""
+    """Resistance vs stroke of the designed brake and the linear damper (peak support force in the legend), drawn on
+    the densified histories (:meth:`~mbs_models.results.result.Result.densified`: at most 1 ms apart; ``-M a``
+    there from the velocity's interpolant).  A matplotlib ``Figure`` of its own (no pyplot state: nothing is left
+    open, the caller's backend unchanged)."""
     from matplotlib.figure import Figure
 
     from .recoil_peaks import RECOIL, peak_forces
@@ -306,13 +308,14 @@ def plot_comparison(comparison: Comparison):
     left, right = fig.subplots(1, 2)
     for result, label, style in ((comparison.designed, "designed brake (constant resistance)", "-"),
                                  (comparison.linear, f"linear damper x {comparison.damper_scale:.3g}", "--")):
-        x, r = recoil_stroke(result)
+        dense = result.densified()  # drawn at most 1 ms apart (the solver's steps reach 20 ms)
+        x, r = recoil_stroke(dense)
         mount = peak_forces(result)["mount"]
         in_recoil = "" if mount.phase == RECOIL else \
             f"; {peak_support_force_in_recoil(result) / 1e3:.2f} kN in recoil"
         left.plot(1e3 * x, r / 1e3, style, label=f"{label}: mount peak {mount.force / 1e3:.2f} kN "
                                                  f"{mount.where}{in_recoil}")
-        right.plot(result.time, result.support_force / 1e3, style, label=label)
+        right.plot(dense.time, dense.support_force / 1e3, style, label=label)
     left.axhline(comparison.design.resistance / 1e3, color="grey", lw=0.8, ls=":",
                  label=f"R = M v0^2 / (2 L_d) = {comparison.design.resistance / 1e3:.2f} kN, "
                        f"L_d = {comparison.design.recoil_length:.4g} m")

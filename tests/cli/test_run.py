@@ -144,7 +144,7 @@ def test_csv_has_the_time_histories_with_units(tmp_path, capsys):
         rows = list(csv.reader(stream))
     header, values = rows[0], np.array(rows[1:], dtype=float)
     assert all(name.endswith("]") and " [" in name for name in header)
-    expected = simulate(model_ii(), 0.5, "draft")
+    expected = simulate(model_ii(), 0.5, "draft").densified()  # the rows are dense (1 ms, or finer: 0.5 s / 2000)
     column = {name: values[:, i] for i, name in enumerate(header)}
     np.testing.assert_array_equal(column["time [s]"], expected.time)
     np.testing.assert_array_equal(column["barrel position [m]"], expected.barrel_position)
@@ -154,6 +154,49 @@ def test_csv_has_the_time_histories_with_units(tmp_path, capsys):
     for name in ("kinetic energy [J]", "stored energy [J]", "dissipated energy [J]", "energy balance error [J]"):
         assert name in column
     assert "time histories (CSV)" in capsys.readouterr().out
+
+
+def _csv_times(path) -> np.ndarray:
+    with path.open(newline="") as stream:
+        return np.array([float(row[0]) for row in list(csv.reader(stream))[1:]])
+
+
+def test_the_history_interval_sets_the_rows_and_step_ends_writes_the_solver_s_points(tmp_path, capsys):
+    """A 5 s ``standard`` run steps up to 20 ms: ``--history-interval 0.002`` gives rows at most 2 ms apart
+    (the step-end samples among them), the default at most 1 ms, ``--step-ends`` the solver's points exactly;
+    the plot is written the same way and the metrics do not change."""
+    expected = simulate(model_ii(), 5.0)
+    assert np.max(np.diff(expected.time)) > 1.9e-2
+    metrics = {}
+    for options, gap in ((["--history-interval", "0.002"], 2e-3), ([], 1e-3), (["--step-ends"], None)):
+        target = tmp_path / f"run{len(metrics)}.csv"
+        plot = tmp_path / f"run{len(metrics)}.png"
+        assert main(["run", "model_ii", "--end-time", "5", "--json", "--csv", str(target), "--plot", str(plot),
+                     *options]) == 0
+        metrics[gap] = json.loads(capsys.readouterr().out)
+        times = _csv_times(target)
+        assert plot.read_bytes().startswith(_PNG)
+        if gap is None:
+            np.testing.assert_array_equal(times, expected.time)
+        else:
+            assert np.max(np.diff(times)) <= gap + 1e-14 and np.all(np.isin(expected.time, times))
+    for values in metrics.values():
+        values.pop("wall_time")
+    assert metrics[2e-3] == metrics[1e-3] == metrics[None]
+
+
+@pytest.mark.parametrize("value", ["0", "-0.001", "5", "1e-7", "nan"])
+def test_a_history_interval_out_of_range_exits_2_on_one_line_before_the_solve(tmp_path, capsys, no_solve, value):
+    target = tmp_path / "run.csv"
+    assert main(["run", "model_ii", "--csv", str(target), "--history-interval", value]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "--history-interval" in err and "from 1e-05 to 1 s" in err
+    assert "Traceback" not in err and not target.exists()
+
+
+def test_step_ends_and_an_interval_are_exclusive(capsys, no_solve):
+    assert main(["run", "model_ii", "--step-ends", "--history-interval", "0.001"]) == 2
+    assert "not allowed with" in capsys.readouterr().err
 
 
 def test_a_barrel_mass_in_tonnes_warns_on_one_line_naming_the_key(tmp_path, capsys):

@@ -62,3 +62,23 @@ def test_linear_pieces_are_the_pieces_of_piecewise_linear():
     for x in np.linspace(0.0, 0.012, 25):
         start, value, slope = LinearPieces(PULSE).at(float(x))
         assert value + slope * (float(x) - start) == piecewise_linear(float(x), PULSE, PYTHON_OPS), x
+
+
+def test_objects_holding_symbolic_variables_copy_and_pickle_without_them():
+    """A contact's onset capture with its lam as an Exudyn symbolic variable (while a solve runs) pickles with
+    None in its place and every number kept: a Result keeps its solve's laws across processes."""
+    import pickle
+
+    import exudyn
+
+    from mbs_models.elements.contact_laws import OnsetCapture
+    from mbs_models.elements.ops import SymbolicVariables
+
+    capture = OnsetCapture(chi=0.5, floor=0.01, offset=0.0)
+    capture.start(-1e-3, 2.0)
+    capture._variable = exudyn.symbolic.Real("lam_test_pickle", capture.lam)
+    with pytest.raises(TypeError):
+        pickle.dumps(capture._variable)
+    back = pickle.loads(pickle.dumps(capture))
+    assert isinstance(capture, SymbolicVariables) and back._variable is None and capture._variable is not None
+    assert back.lam == capture.lam == 0.25 and back.history == capture.history

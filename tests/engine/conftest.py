@@ -7,7 +7,9 @@ import dataclasses
 import numpy as np
 import pytest
 
-NOT_COMPARED = {"wall_time", "timings"}  # attributes and metrics() keys
+#: attributes and metrics() keys; ``mechanism``: the solve's laws (not a result: a fresh object each solve, its
+#: samples compared as ``samples``); ``step_ends``: a densified Result's own (None from a solve)
+NOT_COMPARED = {"wall_time", "timings", "mechanism", "step_ends"}
 
 
 def assert_identical(a, b, where: str = "result") -> None:

@@ -48,3 +48,15 @@ def test_cubics_are_reproduced():
     stack = HermiteStack(t, np.array([2 * t ** 3 - t, t ** 2]), np.array([6 * t ** 2 - 1, 2 * t]))
     grid = np.linspace(0, 1.7, 101)
     np.testing.assert_allclose(stack(grid), [2 * grid ** 3 - grid, grid ** 2], rtol=1e-13, atol=1e-13)
+
+
+def test_the_derivative_of_a_cubic_is_exact_and_the_sampled_derivative_at_the_samples():
+    """The interpolant reproduces a cubic, so its derivative is the cubic's, ``6 t^2 - 1`` and ``2 t``, written
+    out; at the sample times (the interval after, the last one's end) the sampled derivatives themselves."""
+    t = np.array([0.0, 0.3, 1.0, 1.7])
+    dy = np.array([6 * t ** 2 - 1, 2 * t])
+    stack = HermiteStack(t, np.array([2 * t ** 3 - t, t ** 2]), dy)
+    grid = np.linspace(0, 1.7, 101)
+    np.testing.assert_allclose(stack.derivative(grid), [6 * grid ** 2 - 1, 2 * grid], rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(stack.derivative(t), dy, rtol=1e-15, atol=1e-15)
+    np.testing.assert_allclose(stack.derivative(grid, [1]), [2 * grid], rtol=1e-12, atol=1e-12)

@@ -48,13 +48,34 @@ def test_the_energy_columns_balance_as_the_result_says(every_element_run):
 
 def test_csv_round_trips_exactly_and_has_no_missing_cells():
     result = simulate(model_ii(), 0.3, "draft")
-    rows = list(csv.reader(io.StringIO(histories_csv(result))))
-    header = rows[0]
-    values = np.array(rows[1:], dtype=float)
-    assert values.shape == (len(result.time), len(header))
-    for i, (name, column) in enumerate(history_columns(result).items()):
-        assert header[i] == name
-        np.testing.assert_array_equal(values[:, i], column)
+    for shown, text in ((result.densified(), histories_csv(result)), (result, histories_csv(result, step_ends=True))):
+        rows = list(csv.reader(io.StringIO(text)))
+        header = rows[0]
+        values = np.array(rows[1:], dtype=float)
+        assert values.shape == (len(shown.time), len(header))
+        for i, (name, column) in enumerate(history_columns(shown).items()):
+            assert header[i] == name
+            np.testing.assert_array_equal(values[:, i], column)
+
+
+def _times(text: str) -> np.ndarray:
+    rows = list(csv.reader(io.StringIO(text)))
+    assert rows[0][0] == "time [s]"
+    return np.array([float(row[0]) for row in rows[1:]])
+
+
+def test_the_rows_are_dense_by_default_and_the_solver_s_points_on_request():
+    """A 10 s ``standard`` run steps up to 20 ms: the CSV's rows are at most 1 ms apart (the default for a 10 s
+    window; 0.5 ms asked for), with every step-end sample among them; ``step_ends=True`` writes exactly the
+    solver's points."""
+    result = simulate(model_ii(1000.0, 0.0), 10.0)
+    assert np.max(np.diff(result.time)) > 1.9e-2
+    for interval, text in ((1e-3, histories_csv(result)), (5e-4, histories_csv(result, 5e-4))):
+        times = _times(text)
+        assert np.max(np.diff(times)) <= interval + 1e-14
+        assert np.all(np.isin(result.time, times))
+    np.testing.assert_array_equal(_times(histories_csv(result, step_ends=True)), result.time)
+    assert histories_csv(result.densified(), step_ends=True) == histories_csv(result, step_ends=True)
 
 
 def test_a_scene_without_absorbers_has_no_contact_columns():

@@ -56,7 +56,8 @@ def test_without_impacts_there_is_no_zoom():
 
 def test_a_declared_history_with_a_panel_gets_one_after_the_velocities(monkeypatch):
     """The recoil spring given (for this test) a declared force history F = k x_M on a panel in kN: a fourth panel
-    after the velocities, holding k x_M / 1000, with the time axis label moved to it."""
+    after the velocities, holding k x_M / 1000 (on the densified histories drawn), with the time axis label moved
+    to it."""
     import numpy as np
 
     from mbs_models.elements.declaration import History, Outputs
@@ -70,7 +71,7 @@ def test_a_declared_history_with_a_panel_gets_one_after_the_velocities(monkeypat
     assert len(axes) == 4 and axes[2].get_ylabel() == "velocity [m/s]" and axes[3].get_ylabel() == "spring force [kN]"
     (line,) = axes[3].get_lines()
     assert line.get_label() == "recoil spring force"
-    expected = scene.recoil_spring.stiffness * result.barrel_position / 1e3
+    expected = scene.recoil_spring.stiffness * result.densified().barrel_position / 1e3
     assert np.asarray(line.get_ydata()) == pytest.approx(expected, rel=1e-12, abs=1e-12)
     assert axes[3].get_xlabel() == "time [s]" and axes[2].get_xlabel() == ""
 
@@ -91,3 +92,42 @@ def test_the_barrel_displacement_legends_are_in_the_axis_unit():
         assert unit == "mm", label
         # printed to 0.1 mm: within half of that of the result's maximum in mm
         assert abs(float(value) - result.max_barrel_displacement * 1e3) <= 0.05 + 1e-9, label
+
+
+def _history_lines(fig):
+    """The lines of every time-history panel (x in s), the impact zoom's (x in ms) apart, and the markers."""
+    return [line for ax in fig.axes if ax.get_xlabel() != "time [ms]" for line in ax.get_lines()
+            if len(line.get_xdata()) > 2]
+
+
+def test_the_run_plot_draws_dense_histories_or_the_solver_s_points():
+    """A 10 s ``standard`` run (steps up to 20 ms): every history line is drawn through times at most 1 ms apart,
+    the step-end samples among them; ``step_ends=True`` draws the solver's points themselves."""
+    import numpy as np
+
+    result = simulate(model_ii(1000.0, 0.0), 10.0)
+    assert np.max(np.diff(result.time)) > 1.9e-2
+    lines = _history_lines(plot_result(result))
+    assert len(lines) >= 5
+    for line in lines:
+        x = np.asarray(line.get_xdata())
+        assert np.max(np.diff(x)) <= 1e-3 + 1e-14 and np.all(np.isin(result.time, x))
+    for line in _history_lines(plot_result(result, step_ends=True)):
+        np.testing.assert_array_equal(line.get_xdata(), result.time)
+
+
+def test_the_paper_figures_draw_dense_histories():
+    import numpy as np
+
+    from mbs_models.results.plotting import plot_barrel_displacements, plot_contact_histories, plot_first_impact
+
+    results = [simulate(model_ii(1000.0, 0.0), 4.0)]
+    for fig in (plot_barrel_displacements(results, title="x"), plot_contact_histories(results, "absorber_velocity",
+                                                                                      title="v"),
+                plot_first_impact(results, title="F", interval=2e-4)):
+        lines = [line for ax in fig.axes for line in ax.get_lines() if len(line.get_xdata()) > 2]
+        assert lines
+        for line in lines:
+            x = np.asarray(line.get_xdata())
+            gap = 2e-4 * 1e3 if "ms" in line.axes.get_xlabel() else 1e-3
+            assert np.max(np.diff(x)) <= gap * (1 + 1e-9)

@@ -131,3 +131,15 @@ def test_the_comparison_figure_leaves_no_pyplot_figure_open(comparison):
     assert len(fig.axes) == 2
     assert plt.get_fignums() == open_before
     assert matplotlib.get_backend() == backend
+
+
+def test_the_comparison_figure_draws_the_densified_histories(comparison):
+    """The support force over time is drawn through times at most 1 ms apart, every step-end sample among them."""
+    import numpy as np
+
+    from mbs_models.studies.brake_design import plot_comparison
+
+    right = plot_comparison(comparison).axes[1]
+    for line, result in zip(right.get_lines(), (comparison.designed, comparison.linear)):
+        x = np.asarray(line.get_xdata())
+        assert np.max(np.diff(x)) <= 1e-3 + 1e-14 and np.all(np.isin(result.time, x))

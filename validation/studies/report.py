@@ -381,6 +381,7 @@ def _mount_force_figure(data: dict, mass: float):
     ax = axes[0, 0]
     runs = data["runs"]
     for run in (runs[SIMPLIFIED], runs[(MODEL_I, mass)], runs[(MODEL_II, mass)]):
+        run = run.densified()  # the histories 1 ms apart at most (the solver's steps reach 20 ms)
         model, colour = run.scene.model_label, MODEL_COLOURS.get(run.scene.model_label)
         shown = run.time <= MOUNT_FORCE_WINDOW
         label = model
@@ -417,7 +418,7 @@ def _energy_figure(data: dict, mass: float):
     """Where the firing's energy goes: kinetic, stored and dissipated energy of each element vs time, models
     (i) and (ii), gap 0; the sum of them all is the initial kinetic energy of the barrel (up to the error)."""
     from mbs_models.results.plotting import new_figure
-    runs = [data["runs"][(MODEL_I, mass)], data["runs"][(MODEL_II, mass)]]
+    runs = [data["runs"][(MODEL_I, mass)].densified(), data["runs"][(MODEL_II, mass)].densified()]  # 1 ms apart
     fig, axes = new_figure(2, 1, width=10.0, row_height=3.3, sharex=True)
     names = sorted({name for run in runs for _, name, _ in energy_histories(run)})
     colours = {name: _ENERGY_COLOURS[i % len(_ENERGY_COLOURS)] for i, name in enumerate(names)}
