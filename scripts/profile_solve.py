@@ -31,7 +31,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-import exudyn  # noqa: E402
+from mbs_models.engine.exudyn_build import load_exudyn  # noqa: E402
+
+exudyn = load_exudyn()  # the module the engine runs on (the fast one), not the one a bare import picks
 
 from mbs_models import model_ii  # noqa: E402
 from mbs_models.engine.accuracy import solver_settings_for  # noqa: E402
