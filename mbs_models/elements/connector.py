@@ -169,12 +169,7 @@ class Connector(abc.ABC):
         user function (``user_functions``: ``"symbolic"`` -- recorded once, evaluated in C++ -- or
         ``"python"``).  The connector keeps the user function alive (:attr:`index` is the item).
         """
-        from exudyn.itemInterface import ObjectConnectorCoordinateSpringDamper
-
-        stiffness, damping = self.builtin_coefficients()
-        index = mbs.AddObject(ObjectConnectorCoordinateSpringDamper(
-            markerNumbers=[marker_a, marker_b], stiffness=stiffness, damping=damping,
-            visualization={"show": False, "drawSize": -1.0, "color": [-1.0, -1.0, -1.0, -1.0]}))
+        index = add_connector_item(mbs, marker_a, marker_b, *self.builtin_coefficients())
         self._set_user_function(mbs, index, user_functions)
         self.index = index
         return index
@@ -197,13 +192,8 @@ class Connector(abc.ABC):
         """Record :meth:`user_function_law` as the item's spring-force user function (if the law needs one)."""
         if not self.needs_user_function:
             return
-        law = self.user_function_law(ops_for(user_functions))
-
-        def user_function(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
-            return law(displacement, velocity)
-
-        self._user_function = make_user_function(mbs, user_function, user_functions, index)
-        mbs.SetObjectParameter(index, "springForceUserFunction", self._user_function)
+        self._user_function = record_spring_force_law(mbs, index, self.user_function_law(ops_for(user_functions)),
+                                                      user_functions)
 
     # ------------------------------------------------------------------ energy (derived unless closed form)
     def python_stored_energy(self, d: float) -> float:
@@ -368,6 +358,30 @@ class Connector(abc.ABC):
         margin = max(float(np.max(np.abs(np.diff(F, axis=0)), initial=0.0)),
                      float(np.max(np.abs(np.diff(F, axis=1)), initial=0.0)))
         return float(np.max(np.abs(F))) + margin
+
+
+def add_connector_item(mbs, marker_a, marker_b, stiffness: float = 0.0, damping: float = 0.0):
+    """Add Exudyn's ``ObjectConnectorCoordinateSpringDamper`` between two coordinate markers, with its built-in
+    linear law ``F = stiffness d + damping d'`` (N/m, N s/m; a user function recorded on it replaces the law);
+    return its ObjectIndex."""
+    from exudyn.itemInterface import ObjectConnectorCoordinateSpringDamper
+
+    return mbs.AddObject(ObjectConnectorCoordinateSpringDamper(
+        markerNumbers=[marker_a, marker_b], stiffness=stiffness, damping=damping,
+        visualization={"show": False, "drawSize": -1.0, "color": [-1.0, -1.0, -1.0, -1.0]}))
+
+
+def record_spring_force_law(mbs, index, law: Callable, user_functions: str):
+    """Record ``law(d, rate) -> F`` (N, over the backend's ops) as the spring-force user function of the connector
+    item ``index`` (``user_functions``: ``"symbolic"`` or ``"python"``); return what Exudyn holds, which must be kept
+    alive as long as the system."""
+
+    def user_function(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
+        return law(displacement, velocity)
+
+    recorded = make_user_function(mbs, user_function, user_functions, index)
+    mbs.SetObjectParameter(index, "springForceUserFunction", recorded)
+    return recorded
 
 
 class LinearSpringDamper(Connector):

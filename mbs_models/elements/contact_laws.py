@@ -424,15 +424,24 @@ class ContactConnector(Connector):
                          compression_only=self.compression_only, lam=lam)
 
     def user_function_law(self, ops: Ops) -> Callable:
+        """:meth:`law` as Exudyn's user function.  Symbolic: ``select(d > offset, F(d, d'), 0)`` -- every law's force
+        is 0 while the contact is open (``p <= 0``: a zero penetration's power times a finite factor, clipped at 0),
+        and Exudyn evaluates only the branch a selection takes, so an open contact costs a comparison instead of
+        the law (its power function); in contact it is the law's own expression."""
         if self.capture is None:
-            return lambda d, rate: self.law(d, rate, ops)
-        if ops.name == "symbolic":
+            law = lambda d, rate: self.law(d, rate, ops)  # noqa: E731
+        elif ops.name == "symbolic":
             import exudyn
             variable = exudyn.symbolic.Real(f"lam_{self.name}_{id(self)}", self.capture.lam)
             self.capture._variable = variable
-            return lambda d, rate: self.law(d, rate, ops, lam=variable)
-        capture = self.capture
-        return lambda d, rate: self.law(d, rate, ops, lam=capture.lam)
+            law = lambda d, rate: self.law(d, rate, ops, lam=variable)  # noqa: E731
+        else:
+            capture = self.capture
+            law = lambda d, rate: self.law(d, rate, ops, lam=capture.lam)  # noqa: E731
+        if ops.name != "symbolic":
+            return law
+        offset = self.offset
+        return lambda d, rate: ops.select(d > offset, law(d, rate), 0.0)
 
     def force(self, d, rate, t=None):
         lam = None

@@ -4,10 +4,11 @@ The assembly iterates over the scene's elements (:class:`~mbs_models.engine.mech
 each body is a ``NodeGenericODE2`` (1 coordinate) with an ``ObjectMass1D`` and a coordinate marker and
 position/velocity/acceleration sensors; each connector an ``ObjectConnectorCoordinateSpringDamper``
 between its two markers (Exudyn's linear law, or the element's user function), and each contact a force
-sensor.  For the paper's model (ii)::
+sensor.  Connectors between the same two points share one item (:mod:`.folding`: the linear law of their summed
+coefficients, or one user function of their summed forces).  For the paper's model (ii)::
 
-    ground --[recoil_spring k]------- barrel (NodeGenericODE2 + ObjectMass1D, mass M)
-    ground --[recoil_damper c(v)]---- barrel        user function only if c is asymmetric
+    ground --[recoil_spring k + recoil_damper c(v)]-- barrel (NodeGenericODE2 + ObjectMass1D, mass M)
+                                        one item: k x + c(v) v, a user function only if c is asymmetric
     ground --[absorber_damper k_r, c_r]-- absorber (mass m)
     absorber --[contact]----------------- barrel   (user function)
 
@@ -28,6 +29,7 @@ from exudyn.itemInterface import MarkerNodeCoordinate, NodeGenericODE2, NodePoin
 
 from ..elements.connector import GROUND
 from ..scene import Scene
+from .folding import add_item, connector_items, update_item
 from .mechanism import Mechanism
 
 _OVT = exudyn.OutputVariableType
@@ -45,8 +47,10 @@ class Assembly:
     backend: ``"symbolic"`` or ``"python"`` user functions.
     nodes: body name -> NodeIndex; ``markers``: body name (and ``"ground"``) -> MarkerIndex.
     connectors: connector name -> ObjectIndex (``recoil_spring``, ``recoil_damper``, ``absorber_damper``,
-        ``contact``, ...); absent effects are absent keys.
-    user_function_connectors: names of the connectors driven by a user function.
+        ``contact``, ...); absent effects are absent keys; connectors that share an item (:mod:`.folding`) have
+        the same index.
+    user_function_connectors: names of the connectors driven by a user function (their own, or their share of a
+        folded item's).
     loads: load name -> LoadIndex (``breech_force``, ``gravity``): external forces on a body.
     sensors: name -> SensorIndex (``barrel_position`` ... ``absorber_acceleration``, ``contact_force``).
     coordinates: body name -> index of its coordinate in the system's ODE2 coordinates.
@@ -111,12 +115,13 @@ def update_body(mbs, node, mass_object, mass: float, initial_velocity: float, in
     mbs.SetNodeParameter(node, "initialCoordinates_t", [initial_velocity])
 
 
-def structure_key(mechanism: Mechanism, user_functions: str) -> tuple:
+def structure_key(mechanism: Mechanism, user_functions: str, fold: bool = True) -> tuple:
     """What an assembled system is made of, without its numbers: the backend, the bodies (names, in order), the
     connectors (class, name, ends, whether a user function and a force sensor) and the loads (class, name, body,
     user function), element by element.  Two scenes with the same key assemble to the same items; only
-    masses, stiffnesses, laws' constants and initial states differ (see :func:`refill`)."""
-    return (user_functions, tuple(
+    masses, stiffnesses, laws' constants and initial states differ (see :func:`refill`); ``fold``: whether
+    connectors on the same ends share an item (:func:`assemble`; the grouping follows from the rest of the key)."""
+    return (user_functions, fold, tuple(
         (element.name, type(element.table).__name__,
          tuple(body.name for body in element.bodies),
          tuple((type(c).__qualname__, c.name, c.a, c.b, c.needs_user_function, c.records_force)
@@ -125,8 +130,12 @@ def structure_key(mechanism: Mechanism, user_functions: str) -> tuple:
         for element in mechanism.elements))
 
 
-def assemble(scene: Scene, user_functions: str = "symbolic", mechanism: Mechanism | None = None) -> Assembly:
-    """Build the Exudyn system of ``scene``; ``user_functions`` is ``"symbolic"`` or ``"python"``."""
+def assemble(scene: Scene, user_functions: str = "symbolic", mechanism: Mechanism | None = None, *,
+             fold: bool = True) -> Assembly:
+    """Build the Exudyn system of ``scene``; ``user_functions`` is ``"symbolic"`` or ``"python"``.
+
+    ``fold``: connectors between the same two points share one Exudyn item (:mod:`.folding`); False: one item
+    per connector (the same forces to round-off: to compare, and Exudyn's floor in ``scripts/bench.py``)."""
     if user_functions not in USER_FUNCTION_BACKENDS:
         raise ValueError(f"user_functions must be 'symbolic' or 'python', got {user_functions!r}")
     mechanism = Mechanism(scene) if mechanism is None else mechanism
@@ -136,6 +145,8 @@ def assemble(scene: Scene, user_functions: str = "symbolic", mechanism: Mechanis
                         backend=user_functions)
     ground = mbs.AddNode(NodePointGround())
     assembly.markers[GROUND] = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=ground, coordinate=0))
+    items = connector_items(mechanism.connectors) if fold else [(c,) for c in mechanism.connectors]
+    first_of = {members[0].name: members for members in items}
     planar = None
     if scene.carriage is not None:  # the planar model: every body a coordinate of the gun's tree
         from .planar import add_carriage
@@ -156,9 +167,13 @@ def assemble(scene: Scene, user_functions: str = "symbolic", mechanism: Mechanis
                 assembly.sensors[f"{body.name}_{quantity}"] = mbs.AddSensor(
                     SensorNode(nodeNumber=node, outputVariableType=ovt, storeInternal=True))
         for connector in element.connectors:
-            index = connector.add_items(mbs, assembly.markers[connector.a], assembly.markers[connector.b],
-                                        user_functions)
-            assembly.connectors[connector.name] = index
+            members = first_of.get(connector.name)
+            if members is not None:  # the first of the connectors its item holds (engine/folding.py)
+                index = add_item(mbs, members, assembly.markers[connector.a], assembly.markers[connector.b],
+                                 user_functions)
+                for member in members:
+                    assembly.connectors[member.name] = index
+            index = assembly.connectors[connector.name]
             if connector.needs_user_function:
                 assembly.user_function_connectors.append(connector.name)
             if connector.records_force:
@@ -177,7 +192,7 @@ def assemble(scene: Scene, user_functions: str = "symbolic", mechanism: Mechanis
         assembly.coordinates = {name: ltg[k] for name, k in planar.body_coordinate.items()}
     else:
         assembly.coordinates = {name: data.GetNodeLTGODE2(node)[0] for name, node in assembly.nodes.items()}
-    assembly.structure = structure_key(mechanism, user_functions)
+    assembly.structure = structure_key(mechanism, user_functions, fold)
     _start_contacts(mechanism)
     return assembly
 
@@ -216,15 +231,16 @@ def refill(assembly: Assembly, scene: Scene, mechanism: Mechanism) -> Assembly:
     backend = assembly.backend
     if assembly.planar is not None or scene.carriage is not None:
         raise ValueError("a carriage scene is assembled anew for every solve")
-    key = structure_key(mechanism, backend)
+    key = structure_key(mechanism, backend, assembly.structure[1])
     if key != assembly.structure:
         raise ValueError("the scene's structure differs from the assembled system's")
     mbs = assembly.mbs
     for body in mechanism.bodies:
         update_body(mbs, assembly.nodes[body.name], assembly.masses[body.name], body.mass, body.initial_velocity,
                     body.initial_position)
-    for connector in mechanism.connectors:
-        connector.update_items(mbs, assembly.connectors[connector.name], backend)
+    fold = key[1]
+    for members in (connector_items(mechanism.connectors) if fold else [(c,) for c in mechanism.connectors]):
+        update_item(mbs, assembly.connectors[members[0].name], members, backend)
     for load in mechanism.loads:
         load.update_items(mbs, assembly.loads[load.name], backend)
     mbs.SetPreStepUserFunction(0)

@@ -193,6 +193,35 @@ def test_python_and_symbolic_user_functions_agree(law):
     assert len(python.impacts) == len(symbolic.impacts)
 
 
+@pytest.mark.parametrize("law", sorted(CONTACT_LAWS))
+def test_the_symbolic_user_function_is_the_law_in_contact_and_zero_when_open(law):
+    """The recorded user function selects 0 while the contact is open (p <= 0) and the law's own expression
+    otherwise: the same float as the symbolic law in contact (one expression tree, bit for bit), 0 at and before
+    the offset, where the law's force is 0 too (a test above) -- at rates of either sign."""
+    import exudyn
+
+    from mbs_models.elements.ops import symbolic_ops
+    from mbs_models.engine.mechanism import Mechanism
+
+    contact = {"hunt-crossley": hunt_crossley(0.6), "hertz": Contact(gap=0.02, stiffness=2.1e8, exponent=1.3, law="hertz"),
+               "kelvin-voigt": Contact(gap=0.02, stiffness=4e7, law="kelvin-voigt", damping=8e4)}.get(
+        law, restitution_law(law, 0.5) if law in RESTITUTION_LAWS else None)
+    connector = Mechanism(model_ii(500.0, 0.0).with_changes(contact=contact)).connector["contact"]
+    if connector.capture is not None:
+        connector.capture.start(0.0, 0.7)
+    ops = symbolic_ops()
+    recorded = connector.user_function_law(ops)
+    offset = connector.offset
+    for p in (-0.01, -1e-9, 0.0, 1e-9, 1e-4, 0.01):
+        for rate in (-3.0, -0.2, 0.0, 0.5, 4.0):
+            d, v = exudyn.symbolic.Real(offset + p), exudyn.symbolic.Real(rate)
+            value = recorded(d, v).Evaluate()
+            if offset + p > offset:
+                assert value == connector.law(d, v, ops).Evaluate(), (p, rate)
+            else:
+                assert value == 0.0 and connector.python_force(offset + p, rate) == 0.0, (p, rate)
+
+
 def test_kelvin_voigt_jumps_at_the_onset_and_never_pulls():
     contact = Contact(gap=0.01, stiffness=4e7, law="kelvin-voigt", damping=8e4)
     result = simulate(free_impact(contact), 0.2, "reference")

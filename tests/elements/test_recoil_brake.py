@@ -235,12 +235,16 @@ def test_a_discharge_coefficient_of_one_and_a_single_pair_are_allowed():
 # ================================================================================================ Exudyn items
 def test_an_absent_brake_adds_no_exudyn_item():
     """The same scene with and without [recoil_brake]: exactly one Exudyn object (the connector, a user function)
-    more, and no brake connector at all in the paper's models."""
+    more with one item per connector, none with the brake folded into the recoil spring's item (the same ends:
+    engine/folding.py), and no brake connector at all in the paper's models."""
     without = SHIPPED.with_changes(recoil_brake=None)
+    with assemble(SHIPPED, fold=False) as a, assemble(without, fold=False) as b:
+        assert a.mbs.systemData.NumberOfObjects() == b.mbs.systemData.NumberOfObjects() + 1
     with assemble(SHIPPED) as a, assemble(without) as b:
         assert set(a.connectors) == {"recoil_spring", "recoil_brake"} and set(b.connectors) == {"recoil_spring"}
         assert a.user_function_connectors == ["recoil_brake"] and b.user_function_connectors == []
-        assert a.mbs.systemData.NumberOfObjects() == b.mbs.systemData.NumberOfObjects() + 1
+        assert a.mbs.systemData.NumberOfObjects() == b.mbs.systemData.NumberOfObjects()
+        assert a.connectors["recoil_brake"] == a.connectors["recoil_spring"]
         assert a.mbs.systemData.NumberOfNodes() == b.mbs.systemData.NumberOfNodes()
         assert set(a.sensors) == set(b.sensors)  # the brake's force is not a recorded output
     with assemble(model_ii()) as paper:

@@ -183,10 +183,13 @@ def test_only_assembled_when_the_scene_has_the_table():
     with assemble(without) as assembly:
         assert set(assembly.connectors) == {"recoil_spring"}
         objects = assembly.mbs.systemData.NumberOfObjects()
-    with assemble(SHIPPED) as assembly:
+    with assemble(SHIPPED, fold=False) as assembly:  # one item per connector: the damper's own
+        assert assembly.mbs.systemData.NumberOfObjects() == objects + 1
+    with assemble(SHIPPED) as assembly:  # folded into the recoil spring's item (the same ends: engine/folding.py)
         assert set(assembly.connectors) == {"recoil_spring", "measured_damper"}
         assert "measured_damper" in assembly.user_function_connectors
-        assert assembly.mbs.systemData.NumberOfObjects() == objects + 1
+        assert assembly.mbs.systemData.NumberOfObjects() == objects
+        assert assembly.connectors["measured_damper"] == assembly.connectors["recoil_spring"]
 
 
 # ================================================================================================ beyond the table

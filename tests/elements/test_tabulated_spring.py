@@ -250,10 +250,13 @@ def test_only_assembled_when_the_scene_has_the_table():
     with assemble(without) as assembly:
         assert set(assembly.connectors) == {"recoil_damper"}
         objects = assembly.mbs.systemData.NumberOfObjects()
-    with assemble(SHIPPED) as assembly:
+    with assemble(SHIPPED, fold=False) as assembly:  # one item per connector: the spring's own
+        assert assembly.mbs.systemData.NumberOfObjects() == objects + 1
+    with assemble(SHIPPED) as assembly:  # folded into the recoil damper's item (the same ends: engine/folding.py)
         assert set(assembly.connectors) == {"progressive_spring", "recoil_damper"}
         assert "progressive_spring" in assembly.user_function_connectors
-        assert assembly.mbs.systemData.NumberOfObjects() == objects + 1
+        assert assembly.mbs.systemData.NumberOfObjects() == objects
+        assert assembly.connectors["progressive_spring"] == assembly.connectors["recoil_damper"]
 
 
 # ================================================================================================ beyond the table

@@ -31,10 +31,16 @@ def test_simplified_model_has_no_absorber_and_no_contact():
 
 
 def test_symmetric_damper_uses_builtin_linear_damper_without_user_function():
+    """Folded with the recoil spring (the same ends, engine/folding.py) into one built-in item: k and c together;
+    unfolded, the damper's own item holds c alone."""
     scene = simplified_model().with_changes(recoil_damper=RecoilDamper(recoil=8000.0, counter_recoil=8000.0))
     with assemble(scene) as assembly:
         _, user_functions, _ = _inventory(assembly)
         assert user_functions == []
+        damper = assembly.mbs.GetObject(assembly.connectors["recoil_damper"])
+        assert damper["damping"] == 8000.0 and damper["stiffness"] == 27500.0
+        assert assembly.connectors["recoil_spring"] == assembly.connectors["recoil_damper"]
+    with assemble(scene, fold=False) as assembly:
         damper = assembly.mbs.GetObject(assembly.connectors["recoil_damper"])
         assert damper["damping"] == 8000.0 and damper["stiffness"] == 0.0
 
