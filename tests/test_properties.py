@@ -183,15 +183,25 @@ def test_regression_scenes_every_preset(name, accuracy):
 @pytest.mark.parametrize("name", list(LIGHT_UNDAMPED_WORST))
 def test_light_undamped_absorbers_are_the_stated_exception(name):
     """The worst scenes measured of the stated exception are within its bounds at `standard`, and everything else
-    within the guarantee; the scene is in the exception (its predicate) and the guarantee alone would refuse it."""
+    within the guarantee; the scene is in the exception (its predicate)."""
     scene = LIGHT_UNDAMPED_WORST[name]
     assert light_undamped_absorber(scene)
     result = simulate(scene, END_TIME, "standard")
     errors = errors_against_reference(result, reference_for(scene, END_TIME, accuracy="standard"),
                                       TOLERANCES["standard"]["time"])
     assert violations(errors, "standard", LIGHT_UNDAMPED_BOUNDS["standard"]) == [], errors
-    assert violations(errors, "standard") != [], errors  # an exception indeed (else the statement is stale)
     assert physical_violations(result, TOLERANCES["standard"]["energy"]) == []
+
+
+def test_the_light_undamped_exception_is_still_needed():
+    """Some of the worst scenes exceed the plain guarantee (else the statement is stale).  Which ones depends on the
+    machine: their chatter is chaotic, and the reference's numpy kernels round differently on other CPUs (measured:
+    all four here, three of four with numpy's AVX-512 kernels off), so the test asks for at least one."""
+    beyond = [name for name, scene in LIGHT_UNDAMPED_WORST.items()
+              if violations(errors_against_reference(simulate(scene, END_TIME, "standard"),
+                                                     reference_for(scene, END_TIME, accuracy="standard"),
+                                                     TOLERANCES["standard"]["time"]), "standard")]
+    assert beyond
 
 
 #: The draft scan's worst scenes (validation.studies.guarantee.LIGHT_UNDAMPED_BOUNDS["draft"]).
@@ -205,13 +215,23 @@ LIGHT_UNDAMPED_WORST_DRAFT = {
 @pytest.mark.slow
 @pytest.mark.parametrize("name", list(LIGHT_UNDAMPED_WORST_DRAFT))
 def test_light_undamped_absorbers_are_the_stated_exception_at_draft(name):
-    """The draft scan's worst scenes of the exception are within its draft bounds, and beyond the plain guarantee."""
+    """The draft scan's worst scenes of the exception are within its draft bounds (that half the grid is beyond the
+    plain guarantee at draft is what the bounds' comment records; the standard test above keeps the statement
+    from going stale)."""
     scene = LIGHT_UNDAMPED_WORST_DRAFT[name]
     assert light_undamped_absorber(scene)
     errors = errors_against_reference(simulate(scene, END_TIME, "draft"), reference_for(scene, END_TIME, accuracy="draft"),
                                       TOLERANCES["draft"]["time"])
     assert violations(errors, "draft", LIGHT_UNDAMPED_BOUNDS["draft"]) == [], errors
-    assert violations(errors, "draft") != [], errors
+
+
+@pytest.mark.slow
+def test_the_light_undamped_exception_is_still_needed_at_draft():
+    beyond = [name for name, scene in LIGHT_UNDAMPED_WORST_DRAFT.items()
+              if violations(errors_against_reference(simulate(scene, END_TIME, "draft"),
+                                                     reference_for(scene, END_TIME, accuracy="draft"),
+                                                     TOLERANCES["draft"]["time"]), "draft")]
+    assert beyond
 
 
 def test_the_exception_is_a_light_undamped_absorber_on_the_ground():
