@@ -294,7 +294,7 @@ def run_section(quick: bool = False, repeats: int | None = None, before: bool = 
             else:
                 points = bench_before.QUICK_SWEEP_POINTS if quick else bench_before.SWEEP_POINTS
                 history = bench_before.measure({"before": tree, "now": ROOT}, rounds=5 if quick else 9, points=points,
-                                               import_rounds=5 if quick else 9, progress=progress,
+                                               import_rounds=bench_before.IMPORT_ROUNDS, progress=progress,
                                                reading_rounds=1 if quick else 3)
                 history.update(commit=bench_before.BASELINE_COMMIT, points=len(points))
                 if paper:  # one serial run each, alternating (minutes)
