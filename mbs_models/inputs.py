@@ -28,13 +28,15 @@ MAX_INPUT_BYTES = 64 * 2 ** 20
 #: pairs of a tabulated orifice area inside ``[recoil_brake]``, an absorber's contact in ``[[absorber]]``).
 MAX_TOML_NESTING = 32
 
-# a TOML comment or string (skipped: brackets inside do not nest), or one bracket or brace
-_TOKEN = re.compile(r'''\#[^\n]*
+# a TOML comment or string (skipped: brackets inside do not nest), or one bracket or brace; compiled on first use
+# (by re's cache: a run of a scene built in Python reads no TOML)
+_TOKEN = r'''\#[^\n]*
                       | """(?:\\.|[^\\"]|"(?!""))*"""{1,3}
                       | "(?:\\.|[^"\\\n])*"
                       | \'\'\'(?:[^']|'(?!''))*\'\'\'{1,3}
                       | '[^'\n]*'
-                      | [\[\]{}]''', re.VERBOSE | re.DOTALL)
+                      | [\[\]{}]'''
+_TOKEN_FLAGS = re.VERBOSE | re.DOTALL
 
 
 def read_text_file(path: str | Path, key: str, what: str, max_bytes: int | None = None) -> str:
@@ -107,7 +109,7 @@ def bracket_nesting(text: str) -> int:
     """The deepest nesting of ``[`` and ``{`` in TOML ``text`` outside strings and comments (a table header
     ``[a]`` counts 1, ``[[a]]`` 2)."""
     depth = deepest = 0
-    for match in _TOKEN.finditer(text):
+    for match in re.finditer(_TOKEN, text, _TOKEN_FLAGS):
         token = match.group()
         if token in "[{":
             depth += 1

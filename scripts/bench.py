@@ -78,8 +78,14 @@ def ms(seconds: float) -> str:
 # ------------------------------------------------------------------------------------------------ import
 
 def import_cost() -> dict[str, float]:
-    """Import times (s) in a fresh interpreter: exudyn alone, and everything a run needs."""
-    code = ("import time; t0 = time.perf_counter(); import numpy; t1 = time.perf_counter(); import exudyn; "
+    """Import times (s) in a fresh interpreter: numpy, Exudyn (its fast module, as the engine loads it), and
+    everything else a run needs, with the package compiled to bytecode first (as installed; see
+    :mod:`bench_before`)."""
+    import bench_before
+
+    bench_before.compile_tree(ROOT)
+    code = ("import contextlib, io, sys, time; t0 = time.perf_counter(); import numpy; t1 = time.perf_counter(); "
+            "sys.exudynFast = True\nwith contextlib.redirect_stdout(io.StringIO()): import exudyn\n"
             "t2 = time.perf_counter(); import mbs_models.engine.simulation; t3 = time.perf_counter(); "
             "print(t1 - t0, t2 - t1, t3 - t2)")
     runs = []

@@ -16,7 +16,11 @@ that a shared machine's load drifts into both alike (and in alternating order):
   fail on a collapsed step: CPU of the reading (the step guard's stall and collapse windows);
 * import to the first result in a fresh interpreter (``import mbs_models`` and ``simulate(model_ii(), 0.01)``):
   the interpreter's own clock from before the import to the result, the process's wall time and its CPU time
-  (user + system, less sensitive to a shared machine's load); medians.
+  (user + system, less sensitive to a shared machine's load); medians of :data:`IMPORT_ROUNDS` rounds.  Both trees'
+  modules are compiled to bytecode first (``compileall``, as ``pip install`` does): with ``PYTHONDONTWRITEBYTECODE``
+  set, as on some machines, every run would otherwise time Python's compiler on the package's source (some 50 ms).
+  In the same rounds the floor no change of this package moves (:data:`FLOORS`): the bare interpreter
+  (``python -c pass``) and the interpreter importing numpy and Exudyn's fast module, process wall times.
 
 Each ratio is now / before (< 1: faster now).  With both trees at the same code the ratios must come out ~1:
 that is the check that the measurement is fair.
@@ -83,6 +87,12 @@ for line in sys.stdin:
 
 _IMPORT = ("import time; start = time.perf_counter(); import mbs_models; from mbs_models import model_ii, simulate; "
            "simulate(model_ii(), 0.01); print(time.perf_counter() - start, mbs_models.__file__)")
+#: What the first result costs whatever this package does: (name, code) run in a fresh interpreter, process wall.
+FLOORS = (("interpreter (python -c pass)", "pass"),
+          ("interpreter, numpy and Exudyn", "import contextlib, io, sys; sys.exudynFast = True\n"
+                                            "with contextlib.redirect_stdout(io.StringIO()): import numpy, exudyn"))
+#: Rounds of the import measurement (each: both trees and the floors, in alternating order).
+IMPORT_ROUNDS = 15
 
 
 @contextmanager
@@ -144,6 +154,19 @@ def import_once(tree: Path) -> tuple[float, float, float]:
     return float(out[0]), wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
+def compile_tree(tree: Path) -> None:
+    """Compile the package in ``tree`` to bytecode (``__pycache__``, as an installed package has it)."""
+    subprocess.run([sys.executable, "-m", "compileall", "-q", str(tree / "mbs_models")], check=True,
+                   capture_output=True)
+
+
+def floor_once(code: str) -> float:
+    """The process wall time (s) of ``python -c code``."""
+    start = time.perf_counter()
+    subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, cwd=tempfile.gettempdir())
+    return time.perf_counter() - start
+
+
 def paper_cpu(tree: Path) -> tuple[float, float]:
     """(CPU s, user + system, and wall s) of a full serial ``recoil paper --workers 1`` with the code in ``tree``,
     output into a temporary directory."""
@@ -169,13 +192,37 @@ FIXED_COST_CALLS = 50
 COLLAPSING_READING = "compression_only"
 
 
-def measure(trees: dict[str, Path], rounds: int = 9, points=SWEEP_POINTS, import_rounds: int = 9,
+def import_samples(trees: dict[str, Path], samples: dict[str, dict[str, list[float]]], rounds: int = IMPORT_ROUNDS,
+                   progress=lambda message: None) -> dict[str, list[float]]:
+    """Import to the first result with each tree, ``rounds`` times, appended to ``samples[tree name]`` (``"import"``,
+    ``"import process"``, ``"import process cpu"``: s); returns the floors' process wall times (s) of the same rounds,
+    by :data:`FLOORS` name."""
+    for tree in trees.values():  # bytecode as installed, then a warm-up (the file system's cache)
+        compile_tree(tree)
+        import_once(tree)
+    floors: dict[str, list[float]] = {name: [] for name, _ in FLOORS}
+    for round_ in range(rounds):
+        progress(f"before/now: import to the first result, round {round_ + 1} of {rounds}")
+        for name, what in _alternating({**trees, **dict(FLOORS)}, round_):
+            if name in floors:
+                floors[name].append(floor_once(what))
+                continue
+            inside, process, cpu = import_once(what)
+            tree_samples = samples.setdefault(name, {})
+            tree_samples.setdefault("import", []).append(inside)
+            tree_samples.setdefault("import process", []).append(process)
+            tree_samples.setdefault("import process cpu", []).append(cpu)
+    return floors
+
+
+def measure(trees: dict[str, Path], rounds: int = 9, points=SWEEP_POINTS, import_rounds: int = IMPORT_ROUNDS,
             progress=lambda message: None, reading_rounds: int = 3) -> dict:
     """Median times per tree (``{"run wall", "run cpu", "point cpu", "call cpu", "reading cpu", "import", "import
     process", "import process cpu"}`` in s), the files each imported (``"file"``) and whether the trees gave the
     same values (``"same values"``).  ``"call cpu"``: CPU per ``simulate`` of a 1 ms window (model (ii), standard):
     the fixed cost of a call; ``"reading cpu"``: the engine's runs of the :data:`COLLAPSING_READING` reading of the
-    convention study (its cases fail on a collapsed step), in the first ``reading_rounds`` rounds."""
+    convention study (its cases fail on a collapsed step), in the first ``reading_rounds`` rounds.  ``"floor"``: the
+    median process wall time (s) of each of :data:`FLOORS`, measured in the import rounds."""
     samples: dict[str, dict[str, list[float]]] = {name: {} for name in trees}
     values: dict[str, list] = {name: [] for name in trees}
     workers = {name: Worker(tree) for name, tree in trees.items()}
@@ -201,16 +248,9 @@ def measure(trees: dict[str, Path], rounds: int = 9, points=SWEEP_POINTS, import
     finally:
         for worker in workers.values():
             worker.close()
-    for name, tree in trees.items():  # warm-up: the baseline's tree compiles its .pyc files here
-        import_once(tree)
-    for round_ in range(import_rounds):
-        progress(f"before/now: import to the first result, round {round_ + 1} of {import_rounds}")
-        for name, tree in _alternating(trees, round_):
-            inside, process, cpu = import_once(tree)
-            samples[name].setdefault("import", []).append(inside)
-            samples[name].setdefault("import process", []).append(process)
-            samples[name].setdefault("import process cpu", []).append(cpu)
+    floors = import_samples(trees, samples, import_rounds, progress)
     out = {name: {key: statistics.median(v) for key, v in s.items()} for name, s in samples.items()}
+    out["floor"] = {name: statistics.median(v) for name, v in floors.items()}
     for name in trees:
         out[name]["file"] = workers[name].file
         out[name]["values"] = values[name]  # [[displacement m, steps] of the run, [displacement m per point]]

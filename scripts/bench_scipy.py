@@ -275,6 +275,13 @@ def print_before(out: dict) -> None:
     print(f"   import to the first result now: {ms(now['import process'])} the process's wall time (in the interpreter "
           f"{ms(now['import'])}), target <= 150 ms: {'met' if now['import process'] <= 0.150 else 'NOT met'} "
           f"(judged on the process: a CLI call or a sweep worker pays the interpreter's start too)")
+    floor = out.get("floor", {})
+    if floor:
+        bare, libraries = floor["interpreter (python -c pass)"], floor["interpreter, numpy and Exudyn"]
+        print(f"   the floor, in the same rounds: {', '.join(f'{name} {ms(value)}' for name, value in floor.items())}; "
+              f"the first result above the bare interpreter {ms(now['import process'] - bare)} (before "
+              f"{ms(before['import process'] - bare)}), above numpy and Exudyn {ms(now['import process'] - libraries)} "
+              f"(before {ms(before['import process'] - libraries)}): this package's own share")
 
 
 def run_section(quick: bool = False, repeats: int | None = None, before: bool = True, progress=None,
@@ -294,7 +301,7 @@ def run_section(quick: bool = False, repeats: int | None = None, before: bool = 
             else:
                 points = bench_before.QUICK_SWEEP_POINTS if quick else bench_before.SWEEP_POINTS
                 history = bench_before.measure({"before": tree, "now": ROOT}, rounds=5 if quick else 9, points=points,
-                                               import_rounds=5 if quick else 9, progress=progress,
+                                               import_rounds=bench_before.IMPORT_ROUNDS, progress=progress,
                                                reading_rounds=1 if quick else 3)
                 history.update(commit=bench_before.BASELINE_COMMIT, points=len(points))
                 if paper:  # one serial run each, alternating (minutes)
@@ -326,6 +333,7 @@ def summary(accuracy: dict, history: dict | None, start_load) -> dict:
         out["now_before"] = {label: history["now"][key] / history["before"][key] for key, label in names.items()
                              if key in history["now"] and key in history["before"]}
         out["import_process_s"] = history["now"].get("import process")
+        out["import_floor_s"] = history.get("floor")
     return out
 
 

@@ -37,12 +37,68 @@ def test_a_run_imports_no_plotting_table_or_cluster_library():
     assert proc.returncode == 0, proc.stderr
 
 
+#: Modules a first result does not need (issue #24: import to the first result is paid by every CLI call and sweep
+#: worker), each loaded where it is used: the studies, the CLI, the independent reference, plots, a carriage
+#: scene's outputs and planar model, reading TOML or CSV files, misspelt-key suggestions, process pools.
+NOT_FOR_A_FIRST_RESULT = (
+    "mbs_models.studies", "mbs_models.cli", "validation", "mbs_models.results.plotting",
+    "mbs_models.results.sweep_plots", "mbs_models.results.carriage_plots", "mbs_models.results.optimise_plots",
+    "mbs_models.results.carriage", "mbs_models.engine.planar", "mbs_models.engine.reuse",
+    "tomllib", "csv", "difflib", "importlib.metadata", "argparse", "logging", "multiprocessing",
+    "concurrent.futures", "subprocess", "tempfile", "shutil", "statistics")
+#: ... and ``import mbs_models`` alone loads no Exudyn and none of the engine and results (PEP 562 attributes).
+NOT_FOR_AN_IMPORT = NOT_FOR_A_FIRST_RESULT + (
+    "exudyn", "mbs_models.engine", "mbs_models.results.result", "mbs_models.results.postprocess")
+
+
+def _loaded(names) -> str:
+    """Code for a list of the modules of ``names`` (or their submodules) that the process has imported."""
+    return "sorted(m for m in sys.modules if any(m == n or m.startswith(n + '.') for n in %r))" % (names,)
+
+
+def test_import_and_a_first_run_load_only_what_a_run_needs():
+    """Checked on the one scene every benchmark of the issue times (model (ii)) and on a plain ``import``."""
+    proc = _run("import sys, mbs_models; after_import = %s; " % _loaded(NOT_FOR_AN_IMPORT)
+                + "r = mbs_models.simulate(mbs_models.model_ii(1000.0, 0.0), 0.01); after_run = %s; "
+                % _loaded(NOT_FOR_A_FIRST_RESULT)
+                + "assert r.max_barrel_displacement > 0; "
+                "assert not after_import and not after_run, (after_import, after_run)")
+    assert proc.returncode == 0, proc.stderr
+
+
+def test_the_lazy_loading_check_sees_an_eager_import():
+    """The check above fails when one of the modules is imported: here the carriage's outputs and csv."""
+    proc = _run("import sys, mbs_models, csv, mbs_models.results.carriage; loaded = %s; print(loaded)"
+                % _loaded(NOT_FOR_A_FIRST_RESULT))
+    assert proc.returncode == 0, proc.stderr
+    assert "'csv'" in proc.stdout and "'mbs_models.results.carriage'" in proc.stdout
+
+
+def test_a_carriage_metric_of_a_one_dimensional_run_is_none():
+    """``Result`` looks the carriage's metric names up on first use (the module is no longer imported with it)."""
+    import mbs_models
+    from mbs_models.results.carriage import CARRIAGE_METRICS
+
+    result = mbs_models.simulate(mbs_models.model_ii(1000.0, 0.0), 0.01)
+    assert all(getattr(result, name) is None for name in CARRIAGE_METRICS)
+
+
 def test_public_names_resolve():
     import mbs_models
 
     for name in mbs_models.__all__:
         assert getattr(mbs_models, name) is not None, name
     assert isinstance(mbs_models.simulate, types.FunctionType)
+    assert set(mbs_models.__all__) <= set(dir(mbs_models))
+
+
+def test_public_names_resolve_in_a_fresh_interpreter():
+    """Every name of ``__all__`` resolves with nothing imported before (the lazy ones load their modules then),
+    and ``dir()`` lists them all before any is used."""
+    proc = _run("import mbs_models; listed = set(dir(mbs_models)); "
+                "missing = [n for n in mbs_models.__all__ if getattr(mbs_models, n, None) is None]; "
+                "assert not missing and set(mbs_models.__all__) <= listed, (missing, set(mbs_models.__all__) - listed)")
+    assert proc.returncode == 0, proc.stderr
 
 
 # ------------------------------------------------------------------ who imports what (issue #21)

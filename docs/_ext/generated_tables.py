@@ -101,7 +101,20 @@ def bench_tables(data: dict) -> str:
                       "interleaved (below 1: faster now).\n",
                       "| measurement | now / before |", "|---|---:|",
                       *[f"| {name} | {value:.3f} |" for name, value in section["now_before"].items()], ""]
+        if section.get("import_floor_s"):  # (measured on compiled bytecode, as installed, beside its floor)
+            floor = section["import_floor_s"]
+            parts += ["### Import to the first result\n",
+                      "A fresh interpreter that imports the package and runs a first `simulate` (what every CLI call "
+                      "and sweep worker pays), process wall time, beside the floor no change of this package moves "
+                      "(medians of the same interleaved rounds; the package compiled to bytecode, as installed).\n",
+                      "| process | wall time |", "|---|---:|",
+                      f"| `import mbs_models` and a first result | {_milliseconds(section['import_process_s'])} |",
+                      *[f"| {name} | {_milliseconds(value)} |" for name, value in floor.items()], ""]
     return "\n".join(parts)
+
+
+def _milliseconds(seconds: float) -> str:
+    return f"{seconds * 1e3:.0f} ms"
 
 
 def _generate(app) -> None:

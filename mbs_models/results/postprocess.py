@@ -9,6 +9,7 @@ velocity from acceleration); forces between samples are the connectors' laws on 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -19,8 +20,10 @@ from . import element_outputs
 from .peaks import refine_maximum
 from .refinement import Episodes, refine
 from .result import ALL_METRICS, ContactOutput, Impact
-from .carriage import CarriageOutput, carriage_output
 from .samples import Interpolant, Samples
+
+if TYPE_CHECKING:  # (a carriage scene's outputs: imported where a carriage scene is analysed)
+    from .carriage import CarriageOutput
 
 
 def contact_episodes(mechanism, connector, s: Samples, force: np.ndarray, interp: Interpolant,
@@ -171,6 +174,8 @@ def _analyse(mechanism, s: Samples, impact_threshold: float, wanted: tuple[str, 
             s, metrics.support_force, k_support, refined_support)
     metrics.energies = energies(mechanism, s, interp)
     if s.planar:  # a carriage scene: its outputs, and its energies made planar
+        from .carriage import carriage_output  # (imported on first use: the 1-D scenes never load it)
+
         metrics.carriage = carriage_output(mechanism, s, interp, metrics.energies)
     metrics.element_histories, metrics.element_metrics = element_outputs.compute(mechanism, s, interp)
     return metrics

@@ -11,7 +11,6 @@ from ..elements.barrel import BARREL
 from ..elements.declaration import ABSORBER, END_STOP, elements_with
 from ..stop_reason import StopReason
 from . import element_outputs
-from .carriage import CARRIAGE_METRICS
 
 #: Every metric a run can report (and prove final with ``stop_when_final``).
 ALL_METRICS = ("max_barrel_displacement", "peak_contact_force", "max_absorber_velocity", "impacts",
@@ -162,6 +161,8 @@ class Result:
         :func:`~mbs_models.results.element_outputs.lookup`)."""
         if name.startswith("_") or "element_metrics" not in self.__dict__:  # (copy, pickle: before the fields)
             raise AttributeError(name)
+        from .carriage import CARRIAGE_METRICS  # (imported here, not with the module: a run never needs it)
+
         if name in CARRIAGE_METRICS:  # a carriage scene's metric (None without a carriage)
             carriage = self.__dict__.get("carriage")
             return None if carriage is None else getattr(carriage, name)

@@ -51,6 +51,17 @@ def test_the_carriage_and_scipy_sections_are_rendered_with_their_numbers(tables)
     assert "none reached it" in text
     assert "| complete standard run (wall) | 0.877 |" in text and "`0657fb5eda33`" in text
     assert "gun on its carriage" not in tables.bench_tables(_minimal())
+    assert "Import to the first result" not in text  # (no floor measured: not rendered)
+
+
+def test_import_to_the_first_result_is_rendered_beside_its_floor(tables):
+    data = _minimal()
+    data["issue24"] = {"scipy": [], "import_process_s": 0.1324,
+                       "import_floor_s": {"interpreter (python -c pass)": 0.0171,
+                                          "interpreter, numpy and Exudyn": 0.0986}}
+    text = tables.bench_tables(data)
+    assert "| `import mbs_models` and a first result | 132 ms |" in text
+    assert "| interpreter (python -c pass) | 17 ms |" in text and "| interpreter, numpy and Exudyn | 99 ms |" in text
 
 
 def test_the_committed_benchmark_has_the_sections_its_command_ran(tables):
