@@ -77,7 +77,10 @@ def _light_undamped(key: str):
     def compute() -> float:
         from validation.studies.guarantee import LIGHT_UNDAMPED_BOUNDS, LIGHT_UNDAMPED_MASS
 
-        return LIGHT_UNDAMPED_MASS if key == "mass" else LIGHT_UNDAMPED_BOUNDS["standard"][key]
+        if key == "mass":
+            return LIGHT_UNDAMPED_MASS
+        preset, _, name = key.rpartition(":")
+        return LIGHT_UNDAMPED_BOUNDS[preset or "standard"][name]
     return compute
 
 
@@ -92,4 +95,8 @@ NUMBERS.update({
                             "why": "the stated exception's bound on impact times at standard"},
     "light_undamped_metric": {"compute": _light_undamped("metric"), "format": "{:.0e}", "rel_tol": 0.0,
                               "why": "the stated exception's bound on displacements and velocities at standard"},
+    "light_undamped_draft_force": {"compute": _light_undamped("draft:force"), "format": "{:.0e}", "rel_tol": 0.0,
+                                   "why": "the stated exception's bound on peak forces and impact peaks at draft"},
+    "light_undamped_draft_metric": {"compute": _light_undamped("draft:metric"), "format": "{:.0e}", "rel_tol": 0.0,
+                                    "why": "the stated exception's bound on displacements and velocities at draft"},
 })

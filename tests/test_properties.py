@@ -68,6 +68,8 @@ def scenes(draw) -> Scene:
 
 
 def check_scene(scene: Scene, accuracy: str, end_time: float = END_TIME) -> None:
+    """The properties of the module docstring; a scene in the stated exception (a light undamped absorber) is held
+    to the exception's bounds at the presets it names."""
     result = simulate(scene, end_time, accuracy)  # a SimulationError fails the property
     tolerance = TOLERANCES[accuracy]["energy"]
     problems = physical_violations(result, tolerance)
@@ -76,7 +78,8 @@ def check_scene(scene: Scene, accuracy: str, end_time: float = END_TIME) -> None
     mechanical = result.kinetic_energy_history + result.stored_energy_history
     assert np.max(mechanical) <= e0 * (1.0 + tolerance), "energy created"
     ref = reference_for(scene, end_time, (), accuracy)
-    problems = violations(errors_against_reference(result, ref, TOLERANCES[accuracy]["time"]), accuracy)
+    bounds = LIGHT_UNDAMPED_BOUNDS.get(accuracy) if light_undamped_absorber(scene) else None
+    problems = violations(errors_against_reference(result, ref, TOLERANCES[accuracy]["time"]), accuracy, bounds)
     assert not problems, (problems, scene)
 
 
@@ -120,8 +123,9 @@ CHATTERING = model_ii(1.0, 0.0).with_changes(**{
 #: undamped stay within the guarantee.  The stated exception (validation.studies.guarantee.LIGHT_UNDAMPED_BOUNDS;
 #: docs/validation/checks.md), pinned below on the scan's worst scenes.
 STIFF_CHATTER = CHATTERING.with_changes(**{"contact.stiffness": 1e10, "contact.exponent": 2.0})
+#: (STIFF_CHATTER itself meets the guarantee since issue #24's maximum steps: the scan at those steps, the same 45
+#: scenes, found the same worst errors, 4.8e-4 / 4.9e-4 / 3.6e-4 s / 5.0e-5, and every scene within the stated bounds.)
 LIGHT_UNDAMPED_WORST = {
-    "k1e10-n2-v100": STIFF_CHATTER,
     "k1e12-n1.5-v56": CHATTERING.with_changes(**{"contact.stiffness": 1e12, "firing.muzzle_velocity": 56.4}),
     "k1e10-n1.5-v564": CHATTERING.with_changes(**{"contact.stiffness": 1e10, "firing.muzzle_velocity": 564.0}),
     "damped-recoil-k1e12-n1.5-v564": model_ii(1.0, 0.0).with_changes(**{
@@ -188,6 +192,26 @@ def test_light_undamped_absorbers_are_the_stated_exception(name):
     assert violations(errors, "standard", LIGHT_UNDAMPED_BOUNDS["standard"]) == [], errors
     assert violations(errors, "standard") != [], errors  # an exception indeed (else the statement is stale)
     assert physical_violations(result, TOLERANCES["standard"]["energy"]) == []
+
+
+#: The draft scan's worst scenes (validation.studies.guarantee.LIGHT_UNDAMPED_BOUNDS["draft"]).
+LIGHT_UNDAMPED_WORST_DRAFT = {
+    "k1e12-n1.5-v56": LIGHT_UNDAMPED_WORST["k1e12-n1.5-v56"],
+    "k1e12-n1.5-v564": CHATTERING.with_changes(**{"contact.stiffness": 1e12, "firing.muzzle_velocity": 564.0}),
+    "k1e12-n1.5-v100": CHATTERING.with_changes(**{"contact.stiffness": 1e12}),  # an impact on one side only
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", list(LIGHT_UNDAMPED_WORST_DRAFT))
+def test_light_undamped_absorbers_are_the_stated_exception_at_draft(name):
+    """The draft scan's worst scenes of the exception are within its draft bounds, and beyond the plain guarantee."""
+    scene = LIGHT_UNDAMPED_WORST_DRAFT[name]
+    assert light_undamped_absorber(scene)
+    errors = errors_against_reference(simulate(scene, END_TIME, "draft"), reference_for(scene, END_TIME, accuracy="draft"),
+                                      TOLERANCES["draft"]["time"])
+    assert violations(errors, "draft", LIGHT_UNDAMPED_BOUNDS["draft"]) == [], errors
+    assert violations(errors, "draft") != [], errors
 
 
 def test_the_exception_is_a_light_undamped_absorber_on_the_ground():

@@ -29,8 +29,8 @@ from ..studies.grid import MAX_POINTS
 #: What the accuracy presets mean (mbs_models.engine.accuracy.ACCURACY_PRESETS: the worst relative error of
 #: the max barrel displacement stated there, and the time relative to draft).
 ACCURACY_HELP = ("solver accuracy (default: standard): draft = fast, for plots and exploration (max barrel "
-                 "displacement within 1e-4); standard = results (1e-7, ~1.4x draft's time); reference = "
-                 "validation (1e-9, ~1.8x)")
+                 "displacement within 1e-4); standard = results (1e-7, ~1.3x draft's time); reference = "
+                 "validation (1e-9, ~2.9x)")
 
 #: run_sweep's argument names -> the options that give them.
 _OPTIONS = {"out": "--out", "scheduler": "--scheduler", "workers": "--workers", "end_time": "--end-time",

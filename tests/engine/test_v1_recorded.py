@@ -32,6 +32,26 @@ V1_METRICS = ("max_barrel_displacement", "peak_contact_force", "max_absorber_vel
 
 pytestmark = pytest.mark.recorded
 
+#: Recorded runs whose solve changed by design since the recording (at the settings they were recorded with), and
+#: why: their steps, maximum step and histories (sampled by index) are not compared; every metric still is.
+SOLVE_CHANGED = {
+    "graze-stiff-1kN/draft": "issue #24: a run that only grazed a contact with a max step above 5 ms (draft's "
+                             "former 10 ms) is re-solved at 5 ms (DESIGN.md, 'The maximum step')",
+    "ii-m1-kc1e12/draft": "issue #24: a stalled solve with a max step above 5 ms (draft's former 10 ms) is re-solved "
+                          "once at 5 ms before the absolute-tolerance re-solve",
+}
+
+
+def metrics_only(run: dict) -> dict:
+    """A run's record without its steps, maximum step, histories and their largest samples (its scales: the
+    tolerances still use the recorded ones) (:data:`SOLVE_CHANGED`)."""
+    def keep(value):
+        if isinstance(value, dict):
+            return {k: keep(v) for k, v in value.items()
+                    if k not in ("steps", "max_step", "arrays", "scales") and not recorded.is_summary(v)}
+        return value
+    return keep(run)
+
 
 def paper_scene(name: str):
     if name == "simplified":
@@ -41,12 +61,15 @@ def paper_scene(name: str):
     return factory(float(mass[1:]), float(gap[3:]) / 1000.0)
 
 
-def assert_as_recorded(result, scene, record: dict) -> None:
+def assert_as_recorded(result, scene, record: dict, solve_changed: bool = False) -> None:
     new = recorder.record(result, scene, record["accuracy"])
     new["scene"] = scene.name  # recorded for the paper's cases
     # metrics proven final then are still (the early stop's list may have grown with new metrics since)
     new["final_metrics"] = [m for m in new["final_metrics"] if m in V1_METRICS]
-    problems = recorded.differences(new, record, recorded.kind_of_output, record["accuracy"], record["scales"])
+    scales = record["scales"]
+    if solve_changed:
+        new, record = metrics_only(new), metrics_only(record)
+    problems = recorded.differences(new, record, recorded.kind_of_output, record["accuracy"], scales)
     assert not problems, problems[:10]
 
 
@@ -54,7 +77,7 @@ def assert_as_recorded(result, scene, record: dict) -> None:
 def test_paper_cases(key):
     name, preset = key.split("/")
     scene = paper_scene(name)
-    assert_as_recorded(simulate(scene, 10.0, preset), scene, BASELINE["paper"][key])
+    assert_as_recorded(simulate(scene, 10.0, recorded.preset_as_recorded(preset)), scene, BASELINE["paper"][key])
 
 
 @pytest.mark.parametrize("key", sorted(BASELINE["paper_early_stop"]))
@@ -62,7 +85,7 @@ def test_paper_cases_with_early_stop(key):
     name, which = key.split("/")
     metrics = V1_METRICS if which == "all" else ("max_barrel_displacement",)
     scene = paper_scene(name)
-    assert_as_recorded(simulate(scene, 10.0, "standard", stop_when_final=metrics), scene,
+    assert_as_recorded(simulate(scene, 10.0, recorded.preset_as_recorded("standard"), stop_when_final=metrics), scene,
                        BASELINE["paper_early_stop"][key])
 
 
@@ -70,7 +93,8 @@ def test_paper_cases_with_early_stop(key):
 def test_hard_cases(key):
     name, preset = key.split("/")
     case = HARD_CASES_BY_NAME[name]
-    assert_as_recorded(simulate(case.scene, case.end_time, preset), case.scene, BASELINE["hard"][key])
+    assert_as_recorded(simulate(case.scene, case.end_time, recorded.preset_as_recorded(preset)), case.scene,
+                       BASELINE["hard"][key], solve_changed=key in SOLVE_CHANGED)
 
 
 def test_the_record_is_the_first_recording():
@@ -88,7 +112,7 @@ def test_the_comparison_catches_a_change():
 
     record = BASELINE["paper"]["ii-m1000-gap0/standard"]
     scene = paper_scene("ii-m1000-gap0")
-    new = recorder.record(simulate(scene, 10.0, "standard"), scene, "standard")
+    new = recorder.record(simulate(scene, 10.0, recorded.preset_as_recorded("standard")), scene, "standard")
     new["scene"] = scene.name
     new["final_metrics"] = [m for m in new["final_metrics"] if m in V1_METRICS]
     assert not recorded.differences(new, record, recorded.kind_of_output, "standard", record["scales"])
@@ -102,3 +126,13 @@ def test_the_comparison_catches_a_change():
         else:
             changed["impacts"][0][2] *= 1 + 10 * 1e-4
         assert recorded.differences(changed, record, recorded.kind_of_output, "standard", record["scales"]), change
+
+
+def test_the_runs_use_the_settings_they_were_recorded_with():
+    """``recorded.preset_as_recorded`` gives the maximum step each record names (a re-solve's smaller one aside:
+    graze-stiff/draft stepped over its contact then), and the solve-changed runs are recorded runs."""
+    same = [(section, key) for section in ("paper", "paper_early_stop", "hard") for key, record in BASELINE[section].items()
+            if record["max_step"] == recorded.preset_as_recorded(record["accuracy"]).max_step]
+    assert len(same) == sum(len(BASELINE[s]) for s in ("paper", "paper_early_stop", "hard")) - 1
+    assert ("hard", "graze-stiff/draft") not in same
+    assert set(SOLVE_CHANGED) <= set(BASELINE["hard"])

@@ -36,7 +36,20 @@ TOLERANCES = {
 #: for the keys named (the rest unchanged): bounds over a grid of such scenes, not proven for every one;
 #: ``tests/test_properties.py`` leaves the region out of the random scenes and pins the grid's worst scenes.
 LIGHT_UNDAMPED_MASS = 10.0
-LIGHT_UNDAMPED_BOUNDS = {"standard": {"metric": 1e-4, "force": 1e-3, "impact_peak": 1e-3, "time": 5e-4}}
+#: At ``draft`` (issue #24: a scan of the same 45 scenes at draft's settings before and after its maximum step
+#: changed) about half the grid exceeds the plain guarantee either way -- peak forces up to 2.0e-2, impact peaks
+#: 2.0e-2, absorber velocities 1.0e-2, impact times 2.8e-3 s, and one impact a few N above the threshold counted on
+#: one side only -- so the region is stated at draft too; ``impact_mismatch`` is the number of impacts allowed on
+#: one side only.
+LIGHT_UNDAMPED_BOUNDS = {"standard": {"metric": 1e-4, "force": 1e-3, "impact_peak": 1e-3, "time": 5e-4},
+                         "draft": {"metric": 3e-2, "force": 5e-2, "impact_peak": 5e-2, "impact_mismatch": 1}}
+#: A measured residual: a hydraulic brake (the quadratic orifice law) at ``reference``.  The shipped realistic scene
+#: without cradle friction keeps its trajectory within the guarantee (displacement error below 7e-9) but its energy
+#: balance scatters between 1.5e-9 and 8.5e-9 of the initial energy when its designed orifice table moves by 1e-8 to
+#: 1e-5 relative (DOPRI5's error at rtol 1e-11 during the braked recoil: 3.6e-10 at rtol 1e-12, 1.1e-9 with a 1 ms
+#: max step), against the 5e-9 of :data:`TOLERANCES`.  Such a scene is held to these bounds at ``reference``
+#: (``tests/test_realistic_scene.py``; docs/validation/checks.md).
+BRAKE_REFERENCE_BOUNDS = {"reference": {"energy": 1e-8}}
 
 
 def light_undamped_absorber(scene) -> bool:
@@ -195,9 +208,9 @@ def errors_against_reference(result, ref, merge_gap: float = 0.0) -> dict:
 def violations(errors: dict, accuracy: str, bounds: dict | None = None) -> list[str]:
     """The errors of :func:`errors_against_reference` that exceed the preset's :data:`TOLERANCES`, updated by
     ``bounds`` (``{key: bound}``, e.g. the stated exception's :data:`LIGHT_UNDAMPED_BOUNDS`) (empty: all within)."""
-    tol = {**TOLERANCES[accuracy], **(bounds or {})}
+    tol = {"impact_mismatch": 0, **TOLERANCES[accuracy], **(bounds or {})}
     out = []
-    if errors["impact_mismatch"]:
+    if errors["impact_mismatch"] > tol["impact_mismatch"]:
         out.append(f"impacts: {errors['impact_mismatch']} present on one side only")
     for key, bound in (("energy", "energy"), ("x", "metric"), ("v", "metric"), ("dissipated", "metric"),
                        ("F", "force"), ("S", "force"), ("peaks", "impact_peak"), ("time", "time")):
