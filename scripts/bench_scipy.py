@@ -27,7 +27,8 @@ the code before the issue, each as ratios measured in one run.
    the presets' own maximum step, 20 ms; both find the truth's impacts on this case.
    **Why the ratio is what it is** (printed per preset and per metric): the product's steps, its complete run and
    solve per step, Exudyn's floor per step (:func:`profile_solve.run`: the same system with built-in linear laws,
-   no sensors, no pre-step function) and the complete run it would take at the floor (the solve at the floor, the
+   no sensors, no pre-step function, at the ``standard`` settings; a step's cost hardly depends on the tolerance)
+   and the complete run it would take at the floor (the solve at the floor, the
    rest of the run as measured); the script's steps, evaluations of f and its time per evaluation; the ratio the
    script would reach against the run at the floor, and against the floor alone (the whole run at Exudyn's floor per
    step, nothing else: the most any product on Exudyn could reach at the preset's steps).
@@ -211,15 +212,15 @@ def equal_accuracy(repeats: int = 7, quick: bool = False, progress=lambda messag
         for _ in range(2):
             for config in configs:
                 clock(config, script, *config)
-    once = {config: min(wall.pop(config)) for config in configs}
+    warm_up = {config: min(wall.pop(config)) for config in configs}  # the faster of the two
     for config in configs:
         cpu.pop(config)
     timed = set()  # the settings within PRUNE_FACTOR of the fastest candidate of a row they are a candidate of
     for (variant, _, _), by_method in choices.items():
         row_configs = candidates(variant, by_method)
         if row_configs:
-            fastest = min(once[config] for config in row_configs)
-            timed.update(config for config in row_configs if once[config] <= PRUNE_FACTOR * fastest)
+            fastest = min(warm_up[config] for config in row_configs)
+            timed.update(config for config in row_configs if warm_up[config] <= PRUNE_FACTOR * fastest)
     timed = sorted(timed, key=configs.index)
     solve: dict[str, list[float]] = {}
     floor: list[float] = []
@@ -260,7 +261,7 @@ def equal_accuracy(repeats: int = 7, quick: bool = False, progress=lambda messag
                        ratio=t / engine["wall"], cpu_ratio=cpu[key] / engine["cpu"],
                        grid_ratio=wall[(*key, "grid")] / engine["wall"], floor_bound=t / engine["floor_run"],
                        ceiling=t / (engine["steps"] * engine["floor_step"]),
-                       others={config[0]: ((wall[config] if config in timed else once[config]) / engine["wall"],
+                       others={config[0]: ((wall[config] if config in timed else warm_up[config]) / engine["wall"],
                                            config not in timed) for config in row_configs})
         rows.append(row)
     return {"truth": truth, "impacts": impacts, "presets": presets, "rows": rows, "repeats": repeats,
