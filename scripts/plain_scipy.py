@@ -15,8 +15,9 @@ lambda = 0.6 s/m.
 One run is ``solve_ivp`` with dense output, then the three metrics: the largest sample of the solver's own steps
 (the barrel position, the absorber velocity, the contact force computed from the states), refined by a bounded
 scalar search on the dense output between the neighbouring steps (or the same on a uniform grid of the dense
-output, ``grid_spacing``: the same values, at the cost of evaluating the dense output on every step).  ``max_step`` is solve_ivp's default (none)
-unless given: the plain script finds the same impacts as the reference (``scripts/bench_scipy.py`` checks it).
+output, ``grid_spacing``: the same values, at the cost of evaluating the dense output on every step).
+``max_step`` is solve_ivp's default (none) unless given: the plain script finds the same impacts as the reference
+(``scripts/bench_scipy.py`` checks it).
 
     python scripts/plain_scipy.py [METHOD] [RTOL]
 """
@@ -78,7 +79,8 @@ def refined_max(f, t, values):
 def run(method: str = "RK45", rtol: float = 1e-6, atol: float | None = None, max_step: float = np.inf,
         absorber_mass: float = 1000.0, gap: float = 0.0, end_time: float = 10.0,
         grid_spacing: float | None = None) -> dict:
-    """One complete run: integrate, then the metrics (m, N, m/s); also ``steps``, the dense output ``dense``
+    """One complete run: integrate, then the metrics (m, N, m/s); also ``steps``, ``evaluations`` (of ``f``, as
+    ``sol.nfev`` counts them), the dense output ``dense``
     (a callable of t) and the contact-force function ``contact_force``, for checks.  The maxima are searched on
     the solver's steps, or with ``grid_spacing`` (s) on a uniform grid of the dense output."""
     rhs, contact_force = model_ii(absorber_mass, gap)
@@ -96,7 +98,8 @@ def run(method: str = "RK45", rtol: float = 1e-6, atol: float | None = None, max
     v_max, _ = refined_max(lambda s: dense(s)[3], t, y[3])
     f_max, _ = refined_max(lambda s: contact_force(dense(s)[:, None])[0], t, force)
     return {"max_barrel_displacement": float(x_max), "peak_contact_force": float(f_max),
-            "max_absorber_velocity": float(v_max), "steps": len(sol.t) - 1, "dense": dense, "contact_force": contact_force}
+            "max_absorber_velocity": float(v_max), "steps": len(sol.t) - 1, "evaluations": int(sol.nfev),
+            "dense": dense, "contact_force": contact_force}
 
 
 if __name__ == "__main__":

@@ -92,3 +92,35 @@ def test_the_tolerance_is_the_loosest_from_which_on_every_tighter_one_is_as_accu
     # the tightest fails: none is reliable.
     assert bench_scipy.loosest(_rows([1e-9, 1e-7]), "x", 1e-8) == (None, 1e-3)
     assert bench_scipy.relative_error(math.nan, 1.0) == math.inf
+
+
+def test_the_summary_is_strict_json_that_the_performance_page_renders():
+    """bench.py writes the section's summary into docs/_generated/bench.json (no Infinity: 'no max step' is null),
+    and docs/_ext/generated_tables.py renders every row of it with the chosen script's tolerances."""
+    import json
+
+    bench_scipy = _load("bench_scipy")
+    engine = {"errors": {m: 1e-8 for m in bench_scipy.METRICS}, "steps": 1000, "impacts": 6, "wall": 5e-3,
+              "cpu": 5e-3, "solve": 3e-3, "floor_step": 1.5e-6, "floor_run": 3.5e-3}
+    chosen = {"method": "LSODA", "rtol": 1e-8, "atol": 1e-10, "error": 5e-9, "steps": 1500, "evaluations": 3500,
+              "ratio": 3.0, "cpu_ratio": 3.0, "floor_bound": 4.3, "ceiling": 7.5}
+    rows = [{"variant": variant, "preset": "standard", "metric": metric, "target": 1e-8, "max_step": max_step,
+             **(chosen if metric != "peak_contact_force" else {})}
+            for variant, max_step in bench_scipy.VARIANTS.items() for metric in bench_scipy.METRICS]
+    accuracy = {"rows": rows, "presets": {"standard": engine}, "rtols": (1e-3, 1e-11, 33), "repeats": 7}
+    text = json.dumps(bench_scipy.summary(accuracy, None, "0.1 0.2 0.3"), allow_nan=False)
+    data = json.loads(text)["scipy"]
+    assert [row["max_step_s"] for row in data] == [None] * 3 + [0.02] * 3
+    assert all(row["ratio"] is None for row in data if row["metric"] == "peak contact force")
+
+    docs = Path(__file__).resolve().parents[1] / "docs" / "_ext"
+    sys.path.insert(0, str(docs))
+    try:
+        spec = importlib.util.spec_from_file_location("docs_generated_tables", docs / "generated_tables.py")
+        tables = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(tables)
+    finally:
+        sys.path.remove(str(docs))
+    page = "\n".join(tables._scipy_tables(json.loads(text)))
+    assert page.count("| LSODA rtol 1e-08, atol 1e-10 | 5.0e-09 | 3500 | 3.00x | 4.30x | 7.50x | >= 8x |") == 4
+    assert page.count("none reached it") == 2

@@ -64,6 +64,31 @@ def test_import_to_the_first_result_is_rendered_beside_its_floor(tables):
     assert "| interpreter (python -c pass) | 17 ms |" in text and "| interpreter, numpy and Exudyn | 99 ms |" in text
 
 
+def test_the_scipy_section_states_the_search_the_products_runs_and_each_metrics_script(tables):
+    """The JSON shape of scripts/bench_scipy.py's summary: which script, which methods and tolerances, the product's
+    runs beside Exudyn's floor, and per metric the chosen script with its atol, error, evaluations and both ratios."""
+    data = _minimal()
+    data["issue24"] = {
+        "script": {"file": "scripts/plain_scipy.py", "methods": ["RK45", "DOP853", "LSODA", "Radau", "BDF"],
+                   "rtol_first": 1e-3, "rtol_last": 1e-11, "rtol_count": 33, "atol_per_rtol": 0.01, "repeats": 7},
+        "presets": {"standard": {"steps": 1314, "complete_s": 6.1e-3, "solve_s": 3.3e-3, "floor_step_s": 1.5e-6,
+                                 "floor_run_s": 4.77e-3}},
+        "scipy": [{"variant": "no max step (solve_ivp's default)", "preset": "standard", "metric": "peak contact force",
+                   "target_error": 4.7e-8, "method": "LSODA", "rtol": 3.16e-8, "atol": 3.16e-10, "max_step_s": None,
+                   "error": 4.0e-8, "steps": 1655, "evaluations": 3819, "ratio": 2.51, "cpu_ratio": 2.5,
+                   "floor_bound": 3.21, "ceiling": 7.9, "issue_target": 8},
+                  {"variant": "max step 20 ms (the presets')", "preset": "standard",
+                   "metric": "max barrel displacement",
+                   "target_error": 1.8e-9, "method": None, "rtol": None, "atol": None, "max_step_s": 0.02,
+                   "error": None, "steps": None, "evaluations": None, "ratio": None, "cpu_ratio": None,
+                   "floor_bound": None, "ceiling": None, "issue_target": 8}]}
+    text = tables.bench_tables(data)
+    assert "RK45, DOP853, LSODA, Radau, BDF at rtol 1e-03 down to 1e-11 (33 values), atol = rtol x 0.01" in text
+    assert "| `standard` | 1314 | 6.10 ms | 3.30 ms | 2.51 µs | 1.50 µs | 4.77 ms |" in text
+    assert ("| no max step (solve_ivp's default) | `standard` | peak contact force | 4.7e-08 | LSODA rtol 3.2e-08, "
+            "atol 3.2e-10 | 4.0e-08 | 3819 | 2.51x | 3.21x | 7.90x | >= 8x |") in text
+    assert "| max barrel displacement | 1.8e-09 | none reached it | | | - | - | - | >= 8x |" in text
+
 def test_the_committed_benchmark_has_the_sections_its_command_ran(tables):
     data = json.loads((DOCS / "_generated" / "bench.json").read_text())
     command = data["command"]
