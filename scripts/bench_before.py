@@ -76,6 +76,16 @@ for line in sys.stdin:
         cpu = time.process_time()
         outcomes = [engine_job(scene) for scene in scenes]
         answer = {"cpu": time.process_time() - cpu, "failed": sum("error" in outcome for outcome in outcomes)}
+    elif request["what"] == "sweep":  # the Figs 4/5 path: gap_sweep, serial, on the process's kept systems
+        from mbs_models.studies.sweep import gap_sweep
+        groups = {}
+        for model, mass, gap in request["points"]:
+            groups.setdefault((model, mass), []).append(gap)
+        cpu = time.process_time()
+        values = [p.max_barrel_displacement for (model, mass), gaps in groups.items()
+                  for p in gap_sweep(model_i if model == "i" else model_ii, mass, gaps, 10.0, "standard", workers=1,
+                                     stop_when_final=("max_barrel_displacement",))]
+        answer = {"cpu": (time.process_time() - cpu) / len(request["points"]), "values": values}
     else:
         scenes = [(model_i if model == "i" else model_ii)(mass, gap) for model, mass, gap in request["points"]]
         cpu = time.process_time()
@@ -217,8 +227,10 @@ def import_samples(trees: dict[str, Path], samples: dict[str, dict[str, list[flo
 
 def measure(trees: dict[str, Path], rounds: int = 9, points=SWEEP_POINTS, import_rounds: int = IMPORT_ROUNDS,
             progress=lambda message: None, reading_rounds: int = 3) -> dict:
-    """Median times per tree (``{"run wall", "run cpu", "point cpu", "call cpu", "reading cpu", "import", "import
-    process", "import process cpu"}`` in s), the files each imported (``"file"``) and whether the trees gave the
+    """Median times per tree (``{"run wall", "run cpu", "point cpu", "sweep point cpu", "call cpu", "reading cpu",
+    "import", "import process", "import process cpu"}`` in s; ``"point cpu"``: an early-stopped point through
+    ``simulate``, each on a fresh system; ``"sweep point cpu"``: the same points as the Figs 4/5 sweeps run them,
+    ``studies.sweep.gap_sweep`` serial, on the process's kept systems (:mod:`mbs_models.engine.reuse`)), the files each imported (``"file"``) and whether the trees gave the
     same values (``"same values"``).  ``"call cpu"``: CPU per ``simulate`` of a 1 ms window (model (ii), standard):
     the fixed cost of a call; ``"reading cpu"``: the engine's runs of the :data:`COLLAPSING_READING` reading of the
     convention study (its cases fail on a collapsed step), in the first ``reading_rounds`` rounds.  ``"floor"``: the
@@ -230,6 +242,7 @@ def measure(trees: dict[str, Path], rounds: int = 9, points=SWEEP_POINTS, import
         for worker in workers.values():  # warm-up: first calls, caches, symbolic user functions
             worker.ask(what="run")
             worker.ask(what="points", points=[list(p) for p in points[:2]])
+            worker.ask(what="sweep", points=[list(p) for p in points])
         for round_ in range(rounds):
             progress(f"before/now: run and sweep points, round {round_ + 1} of {rounds}")
             for name, worker in _alternating(workers, round_):
@@ -239,6 +252,8 @@ def measure(trees: dict[str, Path], rounds: int = 9, points=SWEEP_POINTS, import
                 samples[name].setdefault("run wall", []).append(run["wall"])
                 samples[name].setdefault("run cpu", []).append(run["cpu"])
                 samples[name].setdefault("point cpu", []).append(sweep["cpu"])
+                samples[name].setdefault("sweep point cpu", []).append(
+                    worker.ask(what="sweep", points=[list(p) for p in points])["cpu"])
                 samples[name].setdefault("call cpu", []).append(call["cpu"])
                 if round_ < reading_rounds:
                     samples[name].setdefault("reading cpu", []).append(

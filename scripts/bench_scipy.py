@@ -333,7 +333,9 @@ def print_before(out: dict) -> None:
               f"largest relative change of a displacement (the run and every sweep point): {moved:.1e}")
     rows = [("complete standard run, model (ii) 10 s (wall)", "run wall", 1 / 1.6),
             ("complete standard run (CPU)", "run cpu", 1 / 1.6),
-            (f"early-stopped sweep point, CPU per point ({out['points']} points)", "point cpu", 1 / 1.5),
+            (f"early-stopped point through simulate(), CPU per point ({out['points']} points)", "point cpu", None),
+            ("early-stopped sweep point as gap_sweep runs it (serial, kept systems), CPU per point", "sweep point cpu",
+             1 / 1.5),
             ("fixed cost of a call: a 1 ms standard run (CPU)", "call cpu", None),
             ("the compression_only reading's engine runs, recoil paper (CPU)", "reading cpu", None),
             ("import to the first result (in the interpreter)", "import", None),
@@ -420,7 +422,9 @@ def summary(accuracy: dict, history: dict | None, start_load) -> dict:
            "presets": presets, "scipy": rows}
     if history is not None:
         names = {"run wall": "complete standard run (wall)", "run cpu": "complete standard run (CPU)",
-                 "point cpu": "early-stopped sweep point (CPU per point)", "call cpu": "fixed cost of a call (CPU)",
+                 "point cpu": "early-stopped point through simulate(), fresh system (CPU per point)",
+                 "sweep point cpu": "early-stopped sweep point as gap_sweep runs it, serial (CPU per point)",
+                 "call cpu": "fixed cost of a call (CPU)",
                  "reading cpu": "the compression_only reading's engine runs (CPU)",
                  "import process": "import to the first result (process wall)"}
         out["commit"] = history["commit"]
