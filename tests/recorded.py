@@ -34,6 +34,7 @@ import math
 import os
 import platform
 import re
+from contextlib import contextmanager
 
 import numpy as np
 
@@ -57,6 +58,31 @@ def preset_as_recorded(name: str):
     return {"draft": SolverSettings(relative_tolerance=1e-6, absolute_tolerance=1e-8, max_step=1e-2),
             "standard": SolverSettings(relative_tolerance=1e-9, absolute_tolerance=1e-11, max_step=5e-3),
             "reference": SolverSettings(relative_tolerance=1e-11, absolute_tolerance=1e-13, max_step=5e-3)}[name]
+
+
+#: The early stop's cadence when the baselines were recorded: the finality tracker was shown the state at the start
+#: of every 4th step, with no time interval (``mbs_models.engine.driver.OBSERVE_EVERY``, ``OBSERVE_INTERVAL``).
+RECORDED_OBSERVE_EVERY = 4
+
+
+@contextmanager
+def early_stop_as_recorded():
+    """The early stop's cadence as it was when the baselines were recorded (:data:`RECORDED_OBSERVE_EVERY`), for
+    the ``with`` block.
+
+    Issue #24 shows the tracker the state once 16 steps or 50 ms passed instead (an evaluation costs about a
+    step): an early stop then ends at another step, so its step count and histories cannot be compared with a
+    record of the old cadence, while its metrics do not move.  The recorded early stops keep their cadence (as
+    :func:`preset_as_recorded` keeps the settings); tests/engine/test_v1_recorded.py checks the metrics at the
+    current cadence against the same records."""
+    from mbs_models.engine import driver
+
+    saved = driver.OBSERVE_EVERY, driver.OBSERVE_INTERVAL
+    driver.OBSERVE_EVERY, driver.OBSERVE_INTERVAL = RECORDED_OBSERVE_EVERY, math.inf
+    try:
+        yield
+    finally:
+        driver.OBSERVE_EVERY, driver.OBSERVE_INTERVAL = saved
 
 
 def load_script(name: str):

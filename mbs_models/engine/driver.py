@@ -49,10 +49,15 @@ from .time_scales import time_scale_hint
 MAX_CONTACT_RETRIES = 3
 #: Re-solves (with max_step / 4 each) when an adaptive solve diverged (NaN or inf in its output).
 MAX_DIVERGENCE_RETRIES = 3
-#: The finality tracker (stop_when_final) is shown the state at every this-many-th step: an observed step's
-#: pre-step call (reading the state, the bounds) costs ~10 us inside a solve, a step ~5 us (the performance
-#: pages; scripts/bench_prestep.py).  Changing it changes when early stops happen (not bit-identical).
-OBSERVE_EVERY = 4
+#: The finality tracker (stop_when_final) is shown the state at the start of a step once this many steps, or
+#: :data:`OBSERVE_INTERVAL` of simulated time, passed since the last state it was shown, whichever comes first.
+#: An observed step's pre-step call (reading the state, the bounds) costs about as much as a step, an unobserved
+#: one a tenth of that (the performance pages; scripts/bench_prestep.py): the step count spares the short steps
+#: of a contact, the interval keeps the stop within a step of the proof where the steps are long.  Changing
+#: either changes when early stops happen (not bit-identical; the metrics do not move).
+OBSERVE_EVERY = 16
+#: See :data:`OBSERVE_EVERY` (s): the longest simulated time between two states shown to the finality tracker.
+OBSERVE_INTERVAL = 0.05
 #: Most output samples kept for fixed-step solvers (output is thinned beyond this, and beyond
 #: :func:`~mbs_models.engine.guard.sample_cap` for a scene with many sensors).
 MAX_FIXED_STEP_SAMPLES = 1_000_000
@@ -136,17 +141,18 @@ def _pre_step_function(assembly: Assembly, budget: StepBudget | None, tracker: F
     rtol <= 1e-10 never passes t = 0.4924 s).  Contacts whose law needs the onset rate ``v-`` see the
     state at the start of every step (Exudyn's current coordinates; ``t`` is the end of the step
     about to be taken, so the start is ``t - currentStepSize``).  The tracker is shown the state at the
-    start of every :data:`OBSERVE_EVERY`-th step; the function returns False once every requested metric
-    is final: Exudyn then completes that step and stops, so the output ends one step after the state
-    that proved finality.
+    start of a step once :data:`OBSERVE_EVERY` steps or :data:`OBSERVE_INTERVAL` s passed since the last
+    one it was shown, whichever comes first; the function returns False once every requested metric is
+    final: Exudyn then completes that step and stops, so the output ends one step after the state that
+    proved finality.
 
     The function is Python called by Exudyn at every step, so it does at each step only what that step
     needs, everything else is looked up once here: one step counter serves the budget (which it calls only
     at :attr:`~mbs_models.engine.guard.StepBudget.next_check`) and the tracker's cadence; the state is read
     only for the captures or an observed step, and passed on as it is where Exudyn's coordinates are the
     bodies in body order (else reordered).  With the budget alone (most adaptive solves) the function only
-    counts: one Python call, an increment and a comparison per step (~0.2 us; the validation pages, "Limits"); with the budget and
-    the tracker alone (a sweep's early stop) it counts and observes every :data:`OBSERVE_EVERY`-th step.
+    counts: one Python call, an increment and a comparison per step (the validation pages, "Limits"); with
+    the budget and the tracker alone (a sweep's early stop) it counts and observes at that cadence.
     ``specialise=False``: the general function in every case (the same calls of the budget and the tracker).
     """
     data = assembly.mbs.systemData
@@ -164,6 +170,7 @@ def _pre_step_function(assembly: Assembly, budget: StepBudget | None, tracker: F
     if planar is not None:  # the carriage's touchdown anchors see the tree's state at every step start
         tree = list(data.GetNodeLTGODE2(planar.node))
     steps = 0  # calls so far (all segments of a run): the budget's step count and the tracker's cadence
+    observe_step, observe_time = OBSERVE_EVERY, OBSERVE_INTERVAL  # the tracker's next state: by count or by time
     next_check = budget.next_check if budget is not None else math.inf
     solver = []  # Exudyn's time-integration state, cached on the first call of each solve
 
@@ -177,7 +184,7 @@ def _pre_step_function(assembly: Assembly, budget: StepBudget | None, tracker: F
         return True
 
     def pre_step(mbs, t):
-        nonlocal steps, next_check
+        nonlocal steps, next_check, observe_step, observe_time
         steps += 1
         if steps >= next_check:  # between checkpoints the budget would only count
             if not budget.advance(steps, t):
@@ -200,8 +207,9 @@ def _pre_step_function(assembly: Assembly, budget: StepBudget | None, tracker: F
                 d = (q[ib] if ib is not None else 0.0) - (q[ia] if ia is not None else 0.0)
                 rate = (v[ib] if ib is not None else 0.0) - (v[ia] if ia is not None else 0.0)
                 capture.observe(t_start, d, rate)
-        if observe is None or steps % OBSERVE_EVERY:
+        if observe is None or (steps < observe_step and t < observe_time):
             return True
+        observe_step, observe_time = steps + OBSERVE_EVERY, t + OBSERVE_INTERVAL
         if q is None:
             q = read_positions(copy=False).tolist()
             v = read_velocities(copy=False).tolist()
@@ -210,14 +218,15 @@ def _pre_step_function(assembly: Assembly, budget: StepBudget | None, tracker: F
         return not observe(t, [q[i] for i in order], [v[i] for i in order])
 
     def count_and_observe(mbs, t):  # the budget and the tracker alone (a sweep's early stop): pre_step's work
-        nonlocal steps, next_check
+        nonlocal steps, next_check, observe_step, observe_time
         steps += 1
         if steps >= next_check:
             if not budget.advance(steps, t):
                 raise _BudgetSpent(f"step budget spent at t = {t:.6g} s")
             next_check = budget.next_check
-        if steps % OBSERVE_EVERY:
+        if steps < observe_step and t < observe_time:
             return True
+        observe_step, observe_time = steps + OBSERVE_EVERY, t + OBSERVE_INTERVAL
         return not observe(t, read_positions(copy=False).tolist(), read_velocities(copy=False).tolist())
 
     if specialise and budget is not None and not captures and planar is None:
