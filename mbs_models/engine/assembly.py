@@ -56,6 +56,9 @@ class Assembly:
     coordinates: body name -> index of its coordinate in the system's ODE2 coordinates.
     masses: body name -> ObjectIndex of its ``ObjectMass1D``.
     structure: :func:`structure_key` of the system (what :func:`refill` needs to match).
+    item_layout: ``(object index, its ODE2 coordinates, has a mass matrix, has an ODE2 LHS)`` per object with
+        ODE2 coordinates, filled by the first evaluation of the initial accelerations
+        (:func:`~mbs_models.engine.driver._initial_accelerations`) and kept by :func:`refill` (the structure's).
     planar: the carriage's items (:class:`~mbs_models.engine.planar.PlanarItems`) of a scene with a
         ``[carriage]``, else None.
     columns: output name -> (sensor name, column) for outputs read from a sensor of several columns (the
@@ -78,6 +81,7 @@ class Assembly:
     structure: tuple = ()
     planar: Any = None
     columns: dict[str, tuple[str, int]] = field(default_factory=dict)
+    item_layout: list[tuple[Any, list[int], bool, bool]] = field(default_factory=list)
 
     def close(self) -> None:
         """Release the Exudyn model (needed for symbolic user functions to be freed)."""
@@ -249,7 +253,7 @@ def refill(assembly: Assembly, scene: Scene, mechanism: Mechanism) -> Assembly:
                         backend=backend, nodes=assembly.nodes, markers=assembly.markers,
                         connectors=assembly.connectors, user_function_connectors=assembly.user_function_connectors,
                         loads=assembly.loads, sensors=assembly.sensors, coordinates=assembly.coordinates,
-                        masses=assembly.masses, structure=key)
+                        masses=assembly.masses, structure=key, item_layout=assembly.item_layout)
     assembly.system_container = assembly.mbs = None  # the system now belongs to the new Assembly
     _start_contacts(mechanism)
     return refilled

@@ -338,18 +338,21 @@ def _initial_accelerations(assembly: Assembly, t: float = 0.0) -> dict[str, floa
     mbs, data = assembly.mbs, assembly.mbs.systemData
     if assembly.planar is not None:
         data.SetTime(t)  # the tree's force user function depends on time (a breech pulse)
-    lhs = np.zeros(data.ODE2Size())
-    mass = np.zeros((data.ODE2Size(), data.ODE2Size()))
+    size = data.ODE2Size()
+    lhs = np.zeros(size)
+    mass = np.zeros((size, size))
     try:
-        for i in range(data.NumberOfObjects()):
-            index = exudyn.ObjectIndex(i)
-            ltg = list(data.GetObjectLTGODE2(i))
-            if not ltg:
+        for index, ltg, has_mass, has_lhs in _item_layout(assembly):
+            if len(ltg) == 1:  # (most objects: one coordinate, no index arrays needed)
+                k = ltg[0]
+                if has_mass:
+                    mass[k, k] += float(np.asarray(mbs.ComputeItem(index, exudyn.ComputeItemType.MassMatrix))[0, 0])
+                if has_lhs:
+                    lhs[k] += float(np.asarray(mbs.ComputeItem(index, exudyn.ComputeItemType.ODE2LHS))[0])
                 continue
-            applies = mbs.ComputeItem(index)
-            if exudyn.ComputeItemType.MassMatrix in applies:
+            if has_mass:
                 mass[np.ix_(ltg, ltg)] += np.asarray(mbs.ComputeItem(index, exudyn.ComputeItemType.MassMatrix))
-            if exudyn.ComputeItemType.ODE2LHS in applies:
+            if has_lhs:
                 lhs[ltg] += np.asarray(mbs.ComputeItem(index, exudyn.ComputeItemType.ODE2LHS), dtype=float)
     except Exception as exc:  # a user function that raises at the initial state
         if _interrupted(exc):
@@ -369,6 +372,22 @@ def _initial_accelerations(assembly: Assembly, t: float = 0.0) -> dict[str, floa
         rhs[data.GetNodeLTGODE2(assembly.nodes[load.body])[0]] += float(load.force(np.array([t]))[0])
     accelerations = np.linalg.solve(mass, rhs)
     return {body: float(accelerations[data.GetNodeLTGODE2(node)[0]]) for body, node in assembly.nodes.items()}
+
+
+def _item_layout(assembly: Assembly) -> list:
+    """:attr:`Assembly.item_layout`, looked up on the first call for the system (the objects, their coordinates
+    and what Exudyn computes for each do not change when a sweep refills the system with new numbers)."""
+    if not assembly.item_layout:
+        data = assembly.mbs.systemData
+        for i in range(data.NumberOfObjects()):
+            ltg = [int(k) for k in data.GetObjectLTGODE2(i)]
+            if not ltg:
+                continue
+            index = exudyn.ObjectIndex(i)
+            applies = assembly.mbs.ComputeItem(index)
+            assembly.item_layout.append((index, ltg, exudyn.ComputeItemType.MassMatrix in applies,
+                                         exudyn.ComputeItemType.ODE2LHS in applies))
+    return assembly.item_layout
 
 
 #: Steps at least per window where a load varies (a breech pulse): the step is limited to its length / this.
