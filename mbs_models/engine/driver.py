@@ -555,7 +555,8 @@ def drive(models: FreshModels, scene: Scene, policy: RunPolicy) -> Solve:
     attempt = diverged = 0
     checked = False
     while True:
-        mechanism = Mechanism(scene)  # fresh: contacts carry the onset capture of one solve
+        # fresh for every solve (contacts carry the onset capture of one solve); the first: the policy's, if built
+        mechanism = policy.mechanism if not checked and policy.mechanism is not None else Mechanism(scene)
         tracker = FinalityTracker(mechanism, policy.requested, policy.impact_threshold) if policy.early_stop else None
         rest = RestWatch.of(mechanism, policy.rest_tolerance, end_time, tracker.bounds if tracker else None)
         if not checked:  # runs the budget would stop, refused before solving (SceneError naming the key)

@@ -16,7 +16,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Sequence
 
 from ..errors import SceneError
@@ -85,6 +85,9 @@ class RunPolicy:
     """How one run is to go: ``settings`` (the solver), ``end_time`` (s, requested), ``impact_threshold`` (N);
     ``requested`` the metrics to prove final, ``early_stop`` whether the run may stop once they are (asked for
     and the scene has energy bounds), ``rest_tolerance`` (m and m/s) the rest watch's (None: no stop at rest).
+    ``mechanism``: the scene's :class:`~mbs_models.engine.mechanism.Mechanism` built to decide ``early_stop``, not
+    used by any solve yet (None where none was built): the driver's first solve takes it rather than building
+    the same again.
     """
 
     settings: SolverSettings
@@ -93,6 +96,7 @@ class RunPolicy:
     requested: tuple[str, ...]
     early_stop: bool
     rest_tolerance: float | None
+    mechanism: Mechanism | None = field(default=None, compare=False, repr=False)
 
     @classmethod
     def of(cls, scene: Scene, end_time: float, accuracy: str | SolverSettings, user_functions: str | None,
@@ -106,8 +110,10 @@ class RunPolicy:
         settings = solver_settings_for(accuracy, user_functions)
         rest_tolerance = settings.absolute_tolerance if stop_at_rest and settings.adaptive else None  # (as asked for)
         stability.check_settings(scene, settings, float(end_time))  # unsafe steps: SceneError before solving
+        mechanism = Mechanism(scene) if requested else None  # (whether the scene has energy bounds)
         return cls(settings=settings, end_time=float(end_time), impact_threshold=float(impact_threshold),
-                   requested=requested, early_stop=bool(requested) and dissipative(scene), rest_tolerance=rest_tolerance)
+                   requested=requested, early_stop=bool(requested) and dissipative(mechanism),
+                   rest_tolerance=rest_tolerance, mechanism=mechanism)
 
 
 def stop_reason(policy: RunPolicy, solve: "Solve", re_solved: bool) -> StopReason:
