@@ -114,9 +114,16 @@ class _QuadraticForm:
         scale = max(float(np.max(np.abs(values))), 0.0) if n else 0.0
         self._keep = values > _RANK_TOLERANCE * scale if scale > 0 else np.zeros(n, dtype=bool)
         self._values, self._vectors = values, vectors
+        self._coefficients: dict[tuple[float, ...], float] = {}  # g -> coefficient(g): connectors share directions
 
     def coefficient(self, g: np.ndarray) -> float:
         """``2 g^T K^+ g`` (so that ``|g.x| <= sqrt(coefficient E)``), or inf if g is not in K's range."""
+        key = tuple(g.tolist())
+        if key not in self._coefficients:
+            self._coefficients[key] = self._coefficient(g)
+        return self._coefficients[key]
+
+    def _coefficient(self, g: np.ndarray) -> float:
         components = self._vectors.T @ g
         outside = components[~self._keep]
         if outside.size and float(np.max(np.abs(outside))) > 1e-9 * max(float(np.max(np.abs(g))), 1.0):
