@@ -59,6 +59,12 @@ def _combine(t0, t1, t, y0, y1, dy0, dy1):
     return _apply(_basis(t0, t1, t), y0, y1, dy0, dy1)
 
 
+#: :meth:`HermiteStack.at_fractions` evaluates all quantities in one pass up to this many values (quantities x
+#: fractions x intervals), one quantity at a time beyond (chosen by timing both ways: the one pass is faster for
+#: the few hundred samples of an early-stopped run, the loop for long runs of many quantities).
+AT_ONCE_ELEMENTS = 2 ** 15
+
+
 class HermiteStack:
     """Piecewise-cubic Hermite interpolants of Q quantities sampled at the same times.
 
@@ -133,19 +139,25 @@ class HermiteStack:
         """Values at ``t_i + f h_i`` for every fraction f and interval i: shape (Q, fractions, intervals).
 
         On a zero-length interval (a jump at a segment boundary, e.g. a shot) the value before the jump.
-        The basis is computed once with the intervals as the last axis (long inner loops), each quantity
-        on it in turn (small temporaries: one (Q, fractions, intervals) array of temporaries costs more
-        in fresh memory pages than in arithmetic).
+        The basis is computed once with the intervals as the last axis (long inner loops).  Up to
+        :data:`AT_ONCE_ELEMENTS` values the quantities are evaluated together (fewer, longer operations);
+        beyond, each on the basis in turn (small temporaries: one (Q, fractions, intervals) array of
+        temporaries then costs more in fresh memory pages than in arithmetic).  Both ways do the same
+        floating-point operations on every value.
         """
         t0, t1 = self.time[:-1], self.time[1:]
         f = np.asarray(fractions, dtype=float)[:, None]
         jump = not np.all(t1 > t0)
         with np.errstate(invalid="ignore", divide="ignore") if jump else nullcontext():
             basis = _basis(t0, t1, t0 + f * (t1 - t0))
-        out = np.empty((len(self.y), f.shape[0], len(t0)))
-        for q in range(len(self.y)):
-            values = _apply(basis, self.y[q, :-1], self.y[q, 1:], self.dy[q, :-1], self.dy[q, 1:])
-            out[q] = np.where(t1 > t0, values, self.y[q, :-1]) if jump else values
+        y, dy = self.y, self.dy
+        if len(y) * f.shape[0] * len(t0) <= AT_ONCE_ELEMENTS:
+            values = _apply(basis, y[:, None, :-1], y[:, None, 1:], dy[:, None, :-1], dy[:, None, 1:])
+            return np.where(t1 > t0, values, y[:, None, :-1]) if jump else values
+        out = np.empty((len(y), f.shape[0], len(t0)))
+        for q in range(len(y)):
+            values = _apply(basis, y[q, :-1], y[q, 1:], dy[q, :-1], dy[q, 1:])
+            out[q] = np.where(t1 > t0, values, y[q, :-1]) if jump else values
         return out
 
     def on_intervals(self, fractions: np.ndarray) -> np.ndarray:

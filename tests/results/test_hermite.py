@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
+from mbs_models.results import hermite as hermite_module
 from mbs_models.results.hermite import HermiteStack, HermiteTrajectory, hermite
 
 
@@ -29,7 +31,11 @@ def test_the_stack_gives_each_quantity_s_hermite_values_bit_for_bit():
         assert np.array_equal(HermiteTrajectory(t, y[q], dy[q])(grid), expected, equal_nan=True)
 
 
-def test_on_intervals_bit_for_bit_and_the_value_before_a_jump():
+@pytest.mark.parametrize("at_once", [True, False], ids=["quantities at once", "one quantity at a time"])
+def test_on_intervals_bit_for_bit_and_the_value_before_a_jump(at_once, monkeypatch):
+    """Both ways of :meth:`HermiteStack.at_fractions` (all quantities in one pass, or in turn beyond
+    AT_ONCE_ELEMENTS values) give hermite()'s values bit for bit."""
+    monkeypatch.setattr(hermite_module, "AT_ONCE_ELEMENTS", 10 ** 9 if at_once else 0)
     t, y, dy = sampled()
     f = np.array([0.1, 0.5, 0.9])
     stacked = HermiteStack(t, y, dy).on_intervals(f)
