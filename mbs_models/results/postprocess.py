@@ -139,6 +139,9 @@ def check_representable(metrics: Metrics, s: Samples) -> None:
             balance = balance + sum(getattr(energy, kind).values(), np.zeros_like(s.time))
         balance = balance - sum(energy.work.values(), np.zeros_like(s.time))
     quantities.append(("sum of the energies (kinetic + stored + dissipated - work)", balance))
+    present = [np.ravel(value) for _, value in quantities if value is not None]
+    if not present or np.isfinite(np.concatenate(present)).all():  # (one pass over all; the first named below)
+        return
     for what, value in quantities:
         if value is not None and not np.all(np.isfinite(value)):
             speed = max(float(np.max(np.abs(v))) for v in s.velocities.values())

@@ -55,3 +55,31 @@ def test_samples_whose_energies_overflow_are_a_simulation_error_without_warnings
         assert "\n" not in str(info.value)
         metrics = analyse(mechanism, samples(1e100), THRESHOLD)
     assert np.isclose(metrics.energies.kinetic["barrel"][-1], 2.8e203, rtol=1e-15, atol=0.0)
+
+
+def test_a_non_finite_quantity_is_named_and_finite_ones_pass():
+    """check_representable looks at every quantity in one pass and names the first one that is not finite, in its
+    order: a contact's force before the energies; and the energy balance's sum, which overflows although every
+    history in it is finite (kinetic 1e308 J + stored 1e308 J)."""
+    from dataclasses import replace
+
+    import numpy as np
+    import pytest
+
+    from mbs_models import SimulationError, model_ii
+    from mbs_models.results.energies import Energies
+    from mbs_models.results.postprocess import analyse, check_representable
+
+    result = simulate(model_ii(), 0.05)
+    metrics = analyse(result.mechanism, result.samples, THRESHOLD)
+    check_representable(metrics, result.samples)  # all finite: passes
+    n = len(result.samples.time)
+    contact = next(iter(metrics.contacts.values()))
+    broken = replace(metrics, contacts={contact.name: replace(contact, force=np.full(n, np.inf))},
+                     energies=replace(metrics.energies, kinetic={"barrel": np.full(n, np.nan)}))
+    with pytest.raises(SimulationError, match=f"the force of {contact.name} is beyond double precision"):
+        check_representable(broken, result.samples)
+    huge = Energies(kinetic={"barrel": np.full(n, 1e308)}, stored={"recoil_spring": np.full(n, 1e308)},
+                    dissipated={}, work={})
+    with pytest.raises(SimulationError, match=r"the sum of the energies \(kinetic \+ stored"):
+        check_representable(replace(metrics, energies=huge), result.samples)
