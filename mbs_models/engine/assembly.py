@@ -59,6 +59,8 @@ class Assembly:
     item_layout: ``(object index, its ODE2 coordinates, has a mass matrix, has an ODE2 LHS)`` per object with
         ODE2 coordinates, filled by the first evaluation of the initial accelerations
         (:func:`~mbs_models.engine.driver._initial_accelerations`) and kept by :func:`refill` (the structure's).
+    simulation_settings: Exudyn ``SimulationSettings`` per ``(SolverSettings, end time, start time)`` solved with
+        (:func:`~mbs_models.engine.driver._simulation_settings`), kept by :func:`refill`.
     planar: the carriage's items (:class:`~mbs_models.engine.planar.PlanarItems`) of a scene with a
         ``[carriage]``, else None.
     columns: output name -> (sensor name, column) for outputs read from a sensor of several columns (the
@@ -82,6 +84,7 @@ class Assembly:
     planar: Any = None
     columns: dict[str, tuple[str, int]] = field(default_factory=dict)
     item_layout: list[tuple[Any, list[int], bool, bool]] = field(default_factory=list)
+    simulation_settings: dict[tuple, Any] = field(default_factory=dict)
 
     def close(self) -> None:
         """Release the Exudyn model (needed for symbolic user functions to be freed)."""
@@ -253,7 +256,8 @@ def refill(assembly: Assembly, scene: Scene, mechanism: Mechanism) -> Assembly:
                         backend=backend, nodes=assembly.nodes, markers=assembly.markers,
                         connectors=assembly.connectors, user_function_connectors=assembly.user_function_connectors,
                         loads=assembly.loads, sensors=assembly.sensors, coordinates=assembly.coordinates,
-                        masses=assembly.masses, structure=key, item_layout=assembly.item_layout)
+                        masses=assembly.masses, structure=key, item_layout=assembly.item_layout,
+                        simulation_settings=assembly.simulation_settings)
     assembly.system_container = assembly.mbs = None  # the system now belongs to the new Assembly
     _start_contacts(mechanism)
     return refilled

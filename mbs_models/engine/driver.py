@@ -104,6 +104,24 @@ def exudyn_simulation_settings(settings: SolverSettings, end_time: float, start_
     return ss
 
 
+def _simulation_settings(assembly: Assembly, settings: SolverSettings, end_time: float, start_time: float):
+    """:func:`exudyn_simulation_settings` for a solve of ``assembly`` (with fewer samples per sensor for a fixed step
+    past :func:`~mbs_models.engine.guard.sample_cap`), made once per system and key (a sweep's points solve the
+    same system with the same settings; :attr:`Assembly.simulation_settings`).  The caller sets the initial step
+    size at every solve."""
+    key = (settings, float(end_time), float(start_time))
+    ss = assembly.simulation_settings.get(key)
+    if ss is None:
+        ss = exudyn_simulation_settings(settings, end_time, start_time)
+        kept = sample_cap(len(assembly.sensors))
+        if not settings.adaptive and ss.timeIntegration.numberOfSteps > kept:  # many sensors: fewer samples each
+            ss.solution.sensors.writePeriod = max(ss.solution.sensors.writePeriod, (end_time - start_time) / kept)
+        if len(assembly.simulation_settings) >= 16:  # (a long optimisation's many end times: keep the latest)
+            assembly.simulation_settings.clear()
+        assembly.simulation_settings[key] = ss
+    return ss
+
+
 class _BudgetSpent(Exception):
     """Stops Exudyn from the pre-step function once the step budget is spent."""
 
@@ -253,13 +271,10 @@ def _solve(assembly: Assembly, settings: SolverSettings, end_time: float,
     segment.
     """
     mbs = assembly.mbs
-    ss = exudyn_simulation_settings(settings, end_time, start_time)
-    kept = sample_cap(len(assembly.sensors))
-    if not settings.adaptive and ss.timeIntegration.numberOfSteps > kept:  # many sensors: fewer samples each
-        ss.solution.sensors.writePeriod = max(ss.solution.sensors.writePeriod, (end_time - start_time) / kept)
+    ss = _simulation_settings(assembly, settings, end_time, start_time)
     first_step = min((c.first_step_limit for c in assembly.mechanism.connectors), default=math.inf)
-    if settings.adaptive and first_step < settings.max_step:  # else Exudyn starts with max_step
-        ss.timeIntegration.initialStepSize = first_step
+    # (0: Exudyn starts with max_step; set at every solve, the settings object being the system's for its key)
+    ss.timeIntegration.initialStepSize = first_step if settings.adaptive and first_step < settings.max_step else 0.0
     solver_type = getattr(exudyn.DynamicSolverType, settings.solver)
     run = {} if run is None else run
     if "budget" not in run:

@@ -8,6 +8,7 @@ structures and numbers have run, and is compared with ``simulate(scene, ...)`` (
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import pytest
 
@@ -103,6 +104,25 @@ def test_pulses_of_hundreds_of_points_are_bit_identical(assert_results_identical
                 assert_results_identical(simulator.simulate(scene, 1.0, accuracy), simulate(scene, 1.0, accuracy))
             assert_results_identical(simulator.simulate(scene, 2.0, "standard", stop_when_final=EARLY),
                                      simulate(scene, 2.0, "standard", stop_when_final=EARLY))
+        assert simulator.assemblies == 1
+
+
+def test_a_kept_system_starts_each_solve_with_its_own_first_step(assert_results_identical):
+    """A brake stiff enough to limit the first step (orifices at 0.3 times the shipped areas: its time constant
+    below the 20 ms maximum step), then the shipped brake (no limit), then the stiff one again, through one system
+    whose Exudyn settings are kept per key: each solve is the fresh one's."""
+    from mbs_models.engine.mechanism import Mechanism
+
+    shipped = load_scene(scene_path("recoil_brake"))
+    brake = shipped.recoil_brake
+    stiff = shipped.with_changes(recoil_brake=replace(
+        brake, orifice_area=tuple((x, 0.3 * a) for x, a in brake.orifice_area)))
+    limits = {name: Mechanism(scene).connector["recoil_brake"].first_step_limit
+              for name, scene in (("stiff", stiff), ("shipped", shipped))}
+    assert limits["stiff"] < 0.02 < limits["shipped"]  # the stiff one's first step is limited, the shipped one's not
+    with Simulator() as simulator:
+        for scene in (stiff, shipped, stiff):
+            assert_results_identical(simulator.simulate(scene, 1.0, "draft"), simulate(scene, 1.0, "draft"))
         assert simulator.assemblies == 1
 
 
