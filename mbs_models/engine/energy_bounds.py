@@ -99,17 +99,44 @@ def connector_ends(mechanism: Mechanism, connector) -> tuple[int | None, int | N
     return (None if connector.a == GROUND else index[connector.a], None if connector.b == GROUND else index[connector.b])
 
 
-class _QuadraticForm:
-    """``x^T K x <= 2E`` of the linear springs: bound coefficients ``2 g^T K^+ g`` of linear combinations."""
+def _stiffness_matrix(mechanism: Mechanism) -> np.ndarray:
+    """K (N/m, bodies x bodies) of the connectors with a quadratic potential: ``sum k g g^T``, g their direction."""
+    n = len(mechanism.bodies)
+    K = np.zeros((n, n))
+    for connector in mechanism.connectors:
+        k = connector.quadratic_stiffness if connector.quadratic_potential else 0.0
+        if k > 0:
+            g = mechanism.direction(connector)
+            K += k * np.outer(g, g)
+    return K
 
-    def __init__(self, mechanism: Mechanism):
-        n = len(mechanism.bodies)
-        K = np.zeros((n, n))
-        for connector in mechanism.connectors:
-            k = connector.quadratic_stiffness if connector.quadratic_potential else 0.0
-            if k > 0:
-                g = mechanism.direction(connector)
-                K += k * np.outer(g, g)
+
+class _QuadraticForm:
+    """``x^T K x <= 2E`` of the linear springs: bound coefficients ``2 g^T K^+ g`` of linear combinations.
+
+    :meth:`of` gives the form of a mechanism, the same object for the same K (a sweep's points share their
+    springs: the eigendecomposition and the coefficients are computed once for them)."""
+
+    #: K (its shape and bytes) -> the form, the :data:`_KEPT` latest
+    _kept: dict[tuple, "_QuadraticForm"] = {}
+    _KEPT = 64
+
+    @classmethod
+    def of(cls, mechanism: Mechanism) -> "_QuadraticForm":
+        """The form of the mechanism's linear springs (a kept one for the same K)."""
+        K = _stiffness_matrix(mechanism)
+        key = (len(K), K.tobytes())
+        form = cls._kept.get(key)
+        if form is None:
+            if len(cls._kept) >= cls._KEPT:
+                del cls._kept[next(iter(cls._kept))]
+            form = cls._kept[key] = cls(K)
+        return form
+
+    def __init__(self, springs: Mechanism | np.ndarray):
+        """The form of a mechanism's linear springs, or of the stiffness matrix K (N/m, bodies x bodies)."""
+        K = _stiffness_matrix(springs) if isinstance(springs, Mechanism) else np.asarray(springs, dtype=float)
+        n = len(K)
         values, vectors = np.linalg.eigh(K)
         scale = max(float(np.max(np.abs(values))), 0.0) if n else 0.0
         self._keep = values > _RANK_TOLERANCE * scale if scale > 0 else np.zeros(n, dtype=bool)
@@ -343,7 +370,7 @@ class EnergyBounds:
         mechanism = scene if isinstance(scene, Mechanism) else Mechanism(scene)
         self.mechanism = mechanism
         self.scene = mechanism.scene
-        form = _QuadraticForm(mechanism)
+        form = _QuadraticForm.of(mechanism)
         index = mechanism.body_index
         self.masses = [b.mass for b in mechanism.bodies]
         self._half_masses = [0.5 * m for m in self.masses]

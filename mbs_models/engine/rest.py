@@ -116,7 +116,7 @@ class RestState:
             return None
         well = bounds.well
         n = len(mechanism.bodies)
-        form = _QuadraticForm(mechanism)
+        form = _QuadraticForm.of(mechanism)
         null = form.null_space()
         unit = np.eye(n)
         gamma, x_r = 0.0, 0.0

@@ -29,6 +29,23 @@ def test_the_bound_coefficients_are_the_closed_forms_of_the_paper_models():
     assert free.contact_coordinate(0, energy) == math.inf  # no spring holds the absorber
 
 
+def test_mechanisms_with_the_same_springs_share_one_quadratic_form_with_a_fresh_one_s_numbers():
+    """A sweep's points (other gaps, other absorber masses) keep their springs: one form, computed once, whose
+    coefficients are a fresh form's bit for bit; other springs give another form."""
+    from mbs_models.engine.mechanism import Mechanism
+
+    mechanisms = [Mechanism(model_ii(mass, gap)) for mass, gap in ((1000.0, 0.0), (100.0, 0.08), (500.0, 0.12))]
+    forms = [eb._QuadraticForm.of(m) for m in mechanisms]
+    assert forms[0] is forms[1] is forms[2]
+    for mechanism in mechanisms:
+        fresh = eb._QuadraticForm(mechanism)
+        for connector in mechanism.connectors:
+            g = mechanism.direction(connector)
+            assert forms[0].coefficient(g) == fresh.coefficient(g)
+    stiffer = Mechanism(model_ii(1000.0, 0.0).with_changes(**{"absorber.stiffness": 2e4}))
+    assert eb._QuadraticForm.of(stiffer) is not forms[0]
+
+
 def test_the_tracker_evaluates_each_contact_with_its_law():
     for scene in (model_ii(), model_ii(100.0, 0.04, Conventions(literal_gap_sign=True)),
                   model_i(500.0, 0.0, Conventions(compression_only=True)),
