@@ -20,10 +20,11 @@ _GL_NODES = 0.5 + 0.5 * np.array([-np.sqrt(0.6), 0.0, np.sqrt(0.6)])
 _GL_WEIGHTS = np.array([5.0, 8.0, 5.0]) / 18.0
 
 
-def cumulative_quadrature(t: np.ndarray, power_at_nodes: np.ndarray) -> np.ndarray:
+def cumulative_quadrature(t: np.ndarray, power_at_nodes: np.ndarray, steps: np.ndarray | None = None) -> np.ndarray:
     """Cumulative integral (J) over the sample intervals from the power (W) at each interval's Gauss nodes
-    (shape (nodes, intervals)): ``E_k = sum_{i<k} h_i sum_j w_j P(t_i + f_j h_i)``."""
-    per_interval = (power_at_nodes * _GL_WEIGHTS[:, None]).sum(axis=0) * np.diff(t)
+    (shape (nodes, intervals)): ``E_k = sum_{i<k} h_i sum_j w_j P(t_i + f_j h_i)``; ``steps``: the intervals'
+    lengths h_i = ``np.diff(t)`` (s), if already at hand."""
+    per_interval = (power_at_nodes * _GL_WEIGHTS[:, None]).sum(axis=0) * (np.diff(t) if steps is None else steps)
     return np.concatenate([[0.0], np.cumsum(per_interval)])
 
 
@@ -62,14 +63,15 @@ def energies(mechanism, s: Samples, interp: Interpolant) -> Energies:
     ``c d'^2`` for a damper, ``F p' - dU/dt`` for a contact).
     """
     t = s.time
-    nodes_t = t[:-1] + _GL_NODES[:, None] * np.diff(t)
+    steps = np.diff(t)
+    nodes_t = t[:-1] + _GL_NODES[:, None] * steps
     x_nodes, v_nodes = interp.at_fractions(_GL_NODES)
     kinetic = {body.name: 0.5 * body.mass * s.velocities[body.name] ** 2 for body in mechanism.bodies}
     stored: dict[str, np.ndarray] = {}
     dissipated: dict[str, np.ndarray] = {}
 
     def quadrature(power):
-        return cumulative_quadrature(t, power)
+        return cumulative_quadrature(t, power, steps)
 
     for connector in mechanism.connectors:
         samples = None
