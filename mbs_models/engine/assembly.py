@@ -232,8 +232,9 @@ def _start_contacts(mechanism: Mechanism) -> None:
 def refill(assembly: Assembly, scene: Scene, mechanism: Mechanism) -> Assembly:
     """The system of ``assembly`` made into the one :func:`assemble` builds for ``scene`` (same
     :func:`structure_key`): every body's mass and initial state, and every connector's and load's numbers and user
-    function (their ``update_items``), written in place; then ``mbs.Assemble()`` (the initial state, as at the
-    first assembly), no pre-step function.  Returns the new :class:`Assembly` (``assembly`` must not be used
+    function (their ``update_items``), written in place (an item whose connectors have the laws it holds keeps its
+    recorded user function: :func:`~mbs_models.engine.folding.update_item`); then ``mbs.Assemble()`` (the initial
+    state, as at the first assembly), no pre-step function.  Returns the new :class:`Assembly` (``assembly`` must not be used
     any more).  ValueError if the structures differ."""
     backend = assembly.backend
     if assembly.planar is not None or scene.carriage is not None:
@@ -246,8 +247,11 @@ def refill(assembly: Assembly, scene: Scene, mechanism: Mechanism) -> Assembly:
         update_body(mbs, assembly.nodes[body.name], assembly.masses[body.name], body.mass, body.initial_velocity,
                     body.initial_position)
     fold = key[1]
+    held = assembly.mechanism.connector  # the connectors the items hold now (the previous point's), by name
     for members in (connector_items(mechanism.connectors) if fold else [(c,) for c in mechanism.connectors]):
-        update_item(mbs, assembly.connectors[members[0].name], members, backend)
+        recorded = tuple(held.get(member.name) for member in members)
+        update_item(mbs, assembly.connectors[members[0].name], members, backend,
+                    None if any(old is None for old in recorded) else recorded)
     for load in mechanism.loads:
         load.update_items(mbs, assembly.loads[load.name], backend)
     mbs.SetPreStepUserFunction(0)

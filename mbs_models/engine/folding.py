@@ -28,6 +28,7 @@ from typing import Sequence
 
 from ..elements.connector import Connector, add_connector_item, record_spring_force_law
 from ..elements.ops import ops_for
+from .law_state import same_laws
 
 
 def foldable(connector: Connector) -> bool:
@@ -94,9 +95,23 @@ def add_item(mbs, members: Sequence[Connector], marker_a, marker_b, user_functio
     return index
 
 
-def update_item(mbs, index, members: Sequence[Connector], user_functions: str = "symbolic") -> None:
+def update_item(mbs, index, members: Sequence[Connector], user_functions: str = "symbolic",
+                recorded: Sequence[Connector] | None = None) -> None:
     """Write the numbers of ``members`` into ``index``, the item :func:`add_item` made for a group of the same
-    classes and ends (:func:`~mbs_models.engine.assembly.refill`)."""
+    classes and ends (:func:`~mbs_models.engine.assembly.refill`).
+
+    ``recorded``: the connectors the item holds now (the previous point's, in the order of ``members``), or None.
+    Where they are plain connectors (``update_items`` not overridden) with the same laws by value
+    (:func:`~mbs_models.engine.law_state.same_laws`) and the user functions are symbolic, the item already is what
+    this function would write: it is left as it is and its recorded user function passes to ``members``."""
+    if (recorded is not None and user_functions == "symbolic"
+            and all(type(member).update_items is Connector.update_items for member in members)
+            and same_laws(recorded, members)):
+        for old, new in zip(recorded, members):
+            if "_user_function" in vars(old):
+                new._user_function = old._user_function
+            new.index = index
+        return
     if len(members) == 1:
         members[0].update_items(mbs, index, user_functions)
         return
