@@ -181,23 +181,31 @@ class Mechanism:
 
     def initial_stored_energy(self) -> float:
         """Stored energy (J) at t = 0, at the initial positions: a contact's initial interference, a preload."""
-        energy = 0.0
+        return self._initial_stored_energies()[0]
+
+    def _initial_stored_energies(self) -> tuple[float, float]:
+        """``(sum U_c, sum |U_c|)`` (J) over the connectors storing energy, at the initial positions."""
+        signed = magnitude = 0.0
         for connector in self.connectors:
             if connector.stores_energy:
-                energy += float(connector.stored_energy(self.initial_relative(connector)))
-        return energy
+                energy = float(connector.stored_energy(self.initial_relative(connector)))
+                signed += energy
+                magnitude += abs(energy)
+        return signed, magnitude
 
     def initial_energy(self) -> float:
         """Mechanical energy at t = 0 in J: kinetic + stored (an initial interference, a preload)."""
-        return self.scene.initial_kinetic_energy + self.initial_stored_energy()
+        return self.initial_energy_and_scale()[0]
 
     def energy_scale(self) -> float:
         """The scale (J) of the energy-balance errors: the initial kinetic energy plus the magnitude of every
         initial stored energy.  It is :meth:`initial_energy` unless a potential is negative at t = 0 (a gas
         spring expanded beyond battery by its preload), where the initial energy may be ~0 while the
         stored energies are not."""
-        energy = 0.0
-        for connector in self.connectors:
-            if connector.stores_energy:
-                energy += abs(float(connector.stored_energy(self.initial_relative(connector))))
-        return self.scene.initial_kinetic_energy + energy
+        return self.initial_energy_and_scale()[1]
+
+    def initial_energy_and_scale(self) -> tuple[float, float]:
+        """``(initial_energy(), energy_scale())`` in J, from one evaluation of the initial stored energies."""
+        kinetic = self.scene.initial_kinetic_energy
+        signed, magnitude = self._initial_stored_energies()
+        return kinetic + signed, kinetic + magnitude

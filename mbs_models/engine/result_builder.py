@@ -129,7 +129,7 @@ def _check_energy_balance(record: RunRecord, fields: dict) -> None:
     """:func:`~mbs_models.engine.stability.check_energy_balance` of the solve: kinetic + stored + dissipated - work
     - initial energy (J) over time, against the mechanism's energy scale plus the largest |work| (J)."""
     time, mechanism = record.samples.time, record.mechanism
-    initial, scale = mechanism.initial_energy(), mechanism.energy_scale()
+    initial, scale = mechanism.initial_energy_and_scale()
     if fields["carriage"] is not None:  # the supports' static penetrations store energy at t = 0 (gravity's: 0)
         supports = [h[0] for name, h in fields["stored_energy_histories"].items() if name.startswith("support.")]
         initial += sum(supports)
