@@ -49,8 +49,8 @@ def same_value(a: Any, b: Any) -> bool:
 def same_law(old, new) -> bool:
     """True if connector ``new`` has the law of connector ``old``: the same class, and every attribute but the
     engine's (:data:`ENGINE_ATTRIBUTES`) equal by value."""
-    if type(old) is not type(new):
-        return False
+    if type(old) is not type(new) or not hasattr(new, "__dict__") or not hasattr(old, "__dict__"):
+        return False  # (another class, or attributes in slots: not compared)
     mine, theirs = vars(new), vars(old)
     names = mine.keys() - ENGINE_ATTRIBUTES
     if names != theirs.keys() - ENGINE_ATTRIBUTES:

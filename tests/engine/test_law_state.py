@@ -116,3 +116,15 @@ def test_python_user_functions_are_always_recorded_anew(assert_results_identical
             scene = model_i(mass, 0.02)
             assert_results_identical(simulator.simulate(scene, 2.0, "draft", user_functions="python"),
                                      simulate(scene, 2.0, "draft", user_functions="python"))
+
+
+def test_connectors_without_an_attribute_dictionary_are_not_compared():
+    """A connector class keeping its numbers in slots: never the same law (recorded anew), never an error."""
+
+    class Slotted:
+        __slots__ = ("k",)
+
+        def __init__(self, k):
+            self.k = k
+
+    assert not same_law(Slotted(1.0), Slotted(1.0))
