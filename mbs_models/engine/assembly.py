@@ -229,17 +229,19 @@ def _start_contacts(mechanism: Mechanism) -> None:
         contact.start(mechanism.initial_relative(contact), mechanism.relative(contact, velocities))
 
 
-def refill(assembly: Assembly, scene: Scene, mechanism: Mechanism) -> Assembly:
+def refill(assembly: Assembly, scene: Scene, mechanism: Mechanism, key: tuple | None = None) -> Assembly:
     """The system of ``assembly`` made into the one :func:`assemble` builds for ``scene`` (same
     :func:`structure_key`): every body's mass and initial state, and every connector's and load's numbers and user
     function (their ``update_items``), written in place (an item whose connectors have the laws it holds keeps its
     recorded user function: :func:`~mbs_models.engine.folding.update_item`); then ``mbs.Assemble()`` (the initial
     state, as at the first assembly), no pre-step function.  Returns the new :class:`Assembly` (``assembly`` must not be used
-    any more).  ValueError if the structures differ."""
+    any more).  ValueError if the structures differ (``key``: the scene's :func:`structure_key`, if already at
+    hand)."""
     backend = assembly.backend
     if assembly.planar is not None or scene.carriage is not None:
         raise ValueError("a carriage scene is assembled anew for every solve")
-    key = structure_key(mechanism, backend, assembly.structure[1])
+    if key is None:
+        key = structure_key(mechanism, backend, assembly.structure[1])
     if key != assembly.structure:
         raise ValueError("the scene's structure differs from the assembled system's")
     mbs = assembly.mbs

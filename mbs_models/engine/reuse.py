@@ -81,7 +81,7 @@ class Simulator(FreshModels):
             self.assemblies += 1
             return assemble(scene, user_functions, mechanism)
         try:
-            assembly = refill(kept, scene, mechanism)
+            assembly = refill(kept, scene, mechanism, key)
         except BaseException:
             kept.close()
             raise
