@@ -56,8 +56,8 @@ class Assembly:
     coordinates: body name -> index of its coordinate in the system's ODE2 coordinates.
     masses: body name -> ObjectIndex of its ``ObjectMass1D``.
     structure: :func:`structure_key` of the system (what :func:`refill` needs to match).
-    item_layout: ``(object index, its ODE2 coordinates, has a mass matrix, has an ODE2 LHS)`` per object with
-        ODE2 coordinates, filled by the first evaluation of the initial accelerations
+    item_layout: ``(object index, its ODE2 coordinates, has a mass matrix, has an ODE2 LHS, the body whose
+        ObjectMass1D it is or None)`` per object with ODE2 coordinates, filled by the first evaluation of the initial accelerations
         (:func:`~mbs_models.engine.driver._initial_accelerations`) and kept by :func:`refill` (the structure's).
     simulation_settings: Exudyn ``SimulationSettings`` per ``(SolverSettings, end time, start time)`` solved with
         (:func:`~mbs_models.engine.driver._simulation_settings`), kept by :func:`refill`.
@@ -83,7 +83,7 @@ class Assembly:
     structure: tuple = ()
     planar: Any = None
     columns: dict[str, tuple[str, int]] = field(default_factory=dict)
-    item_layout: list[tuple[Any, list[int], bool, bool]] = field(default_factory=list)
+    item_layout: list[tuple[Any, list[int], bool, bool, str | None]] = field(default_factory=list)
     simulation_settings: dict[tuple, Any] = field(default_factory=dict)
 
     def close(self) -> None:

@@ -356,8 +356,12 @@ def _initial_accelerations(assembly: Assembly, t: float = 0.0) -> dict[str, floa
     size = data.ODE2Size()
     lhs = np.zeros(size)
     mass = np.zeros((size, size))
+    masses = {body.name: body.mass for body in assembly.mechanism.bodies}
     try:
-        for index, ltg, has_mass, has_lhs in _item_layout(assembly):
+        for index, ltg, has_mass, has_lhs, body in _item_layout(assembly):
+            if body is not None:  # a body's ObjectMass1D: mass matrix [m] (the mass it was given), no LHS
+                mass[ltg[0], ltg[0]] += masses[body]
+                continue
             if len(ltg) == 1:  # (most objects: one coordinate, no index arrays needed)
                 k = ltg[0]
                 if has_mass:
@@ -384,24 +388,31 @@ def _initial_accelerations(assembly: Assembly, t: float = 0.0) -> dict[str, floa
         out.update((name, float(accelerations[ltg[k]])) for k, name in enumerate(CARRIAGE_COORDINATES))
         return out
     for load in assembly.mechanism.loads:  # external loads at t (the objects' LHS does not hold them)
-        rhs[data.GetNodeLTGODE2(assembly.nodes[load.body])[0]] += float(load.force(np.array([t]))[0])
+        rhs[assembly.coordinates[load.body]] += float(load.force(np.array([t]))[0])
     accelerations = np.linalg.solve(mass, rhs)
-    return {body: float(accelerations[data.GetNodeLTGODE2(node)[0]]) for body, node in assembly.nodes.items()}
+    return {body: float(accelerations[assembly.coordinates[body]]) for body in assembly.nodes}
 
 
 def _item_layout(assembly: Assembly) -> list:
     """:attr:`Assembly.item_layout`, looked up on the first call for the system (the objects, their coordinates
-    and what Exudyn computes for each do not change when a sweep refills the system with new numbers)."""
+    and what Exudyn computes for each do not change when a sweep refills the system with new numbers).
+
+    A body's ``ObjectMass1D`` (:func:`~mbs_models.engine.assembly.add_body`) is marked with the body's name: its
+    mass matrix is the body's mass and its LHS is 0 (Exudyn's ``ObjectMass1D`` has no force of its own), so
+    nothing is asked of Exudyn for it (tests/engine/test_driver.py compares with asking)."""
     if not assembly.item_layout:
         data = assembly.mbs.systemData
+        body_of = {int(index): body for body, index in assembly.masses.items()}
         for i in range(data.NumberOfObjects()):
             ltg = [int(k) for k in data.GetObjectLTGODE2(i)]
             if not ltg:
                 continue
             index = exudyn.ObjectIndex(i)
             applies = assembly.mbs.ComputeItem(index)
+            body = body_of.get(i) if len(ltg) == 1 and assembly.mbs.GetObject(index)["objectType"] == "Mass1D" \
+                else None
             assembly.item_layout.append((index, ltg, exudyn.ComputeItemType.MassMatrix in applies,
-                                         exudyn.ComputeItemType.ODE2LHS in applies))
+                                         exudyn.ComputeItemType.ODE2LHS in applies, body))
     return assembly.item_layout
 
 

@@ -172,3 +172,50 @@ def test_the_specialised_pre_step_functions_stop_where_the_general_one_does(monk
     monkeypatch.setattr(driver, "_pre_step_function",
                         lambda assembly, budget, tracker: general(assembly, budget, tracker, specialise=False))
     assert outcomes() == specialised
+
+
+def test_initial_accelerations_are_exudyns_own_where_its_mass_objects_are_not_asked():
+    """The initial accelerations take a body's ObjectMass1D as its mass and no force (driver._item_layout): the same
+    floats as asking Exudyn for every object's mass matrix and LHS, on every shipped 1-D scene and after a refill
+    with other numbers."""
+    import exudyn
+    import numpy as np
+
+    from mbs_models import load_scene
+    from mbs_models.engine.assembly import assemble, refill
+    from mbs_models.engine.driver import _initial_accelerations
+    from mbs_models.engine.mechanism import Mechanism
+    from mbs_models.scenes import list_scenes, scene_path
+
+    def asking_exudyn(assembly):
+        mbs, data = assembly.mbs, assembly.mbs.systemData
+        size = data.ODE2Size()
+        lhs, mass = np.zeros(size), np.zeros((size, size))
+        for i in range(data.NumberOfObjects()):
+            ltg = list(data.GetObjectLTGODE2(i))
+            if not ltg:
+                continue
+            index = exudyn.ObjectIndex(i)
+            applies = mbs.ComputeItem(index)
+            if exudyn.ComputeItemType.MassMatrix in applies:
+                mass[np.ix_(ltg, ltg)] += np.asarray(mbs.ComputeItem(index, exudyn.ComputeItemType.MassMatrix))
+            if exudyn.ComputeItemType.ODE2LHS in applies:
+                lhs[ltg] += np.asarray(mbs.ComputeItem(index, exudyn.ComputeItemType.ODE2LHS), dtype=float)
+        rhs = -lhs
+        for load in assembly.mechanism.loads:
+            rhs[data.GetNodeLTGODE2(assembly.nodes[load.body])[0]] += float(load.force(np.array([0.0]))[0])
+        a = np.linalg.solve(mass, rhs)
+        return {body: float(a[data.GetNodeLTGODE2(node)[0]]) for body, node in assembly.nodes.items()}
+
+    scenes = [load_scene(scene_path(name)) for name in list_scenes()]
+    scenes = [scene for scene in scenes if scene.carriage is None]
+    assert len(scenes) >= 15
+    for scene in scenes:
+        assembly = assemble(scene)
+        try:
+            assert _initial_accelerations(assembly) == asking_exudyn(assembly), scene.name
+            other = scene.with_changes(**{"barrel.mass": scene.barrel.mass * 1.07})
+            assembly = refill(assembly, other, Mechanism(other))
+            assert _initial_accelerations(assembly) == asking_exudyn(assembly), scene.name
+        finally:
+            assembly.close()
