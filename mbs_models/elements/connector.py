@@ -120,6 +120,15 @@ class Connector(abc.ABC):
     stores_energy = True
     #: True if the connector may dissipate energy (the default: the derived dissipated power is then integrated).
     dissipates = True
+    #: True for a law whose ``offset`` attribute (m) enters only as ``d - offset`` and ``d > offset``: the Exudyn
+    #: item then holds the offset and passes it to the user function, :meth:`user_function_law` returns
+    #: ``f(d, rate, offset)``, and a sweep's kept item serves another offset without recording the law again
+    #: (:mod:`mbs_models.engine.law_state`).  False (the default): ``f(d, rate)`` with every number in the law.
+    offset_in_item = False
+    #: Attributes the law does not read (kept for other uses: the table it was made from, say), left out when a
+    #: sweep decides whether a kept item's recorded law serves this connector (:mod:`mbs_models.engine.law_state`).
+    #: Leave empty unless every number the law reads is an attribute of its own (tested for the contacts).
+    law_state_ignores: frozenset = frozenset()
 
     def __init__(self, name: str, element: str, a: str, b: str):
         if a == b:
@@ -141,7 +150,8 @@ class Connector(abc.ABC):
         """The force in N at relative coordinate ``d`` (m) and rate ``rate`` (m/s), over ``ops``."""
 
     def user_function_law(self, ops: Ops) -> Callable:
-        """``f(d, rate)`` to record as Exudyn's spring-force user function (see :meth:`law`)."""
+        """``f(d, rate)`` to record as Exudyn's spring-force user function (see :meth:`law`); ``f(d, rate,
+        offset)`` for a connector with :attr:`offset_in_item`."""
         return lambda d, rate: self.law(d, rate, ops)
 
     def force(self, d, rate, t=None):
@@ -170,6 +180,8 @@ class Connector(abc.ABC):
         ``"python"``).  The connector keeps the user function alive (:attr:`index` is the item).
         """
         index = add_connector_item(mbs, marker_a, marker_b, *self.builtin_coefficients())
+        if self.offset_in_item:
+            mbs.SetObjectParameter(index, "offset", self.offset)
         self._set_user_function(mbs, index, user_functions)
         self.index = index
         return index
@@ -185,6 +197,8 @@ class Connector(abc.ABC):
         stiffness, damping = self.builtin_coefficients()
         mbs.SetObjectParameter(index, "stiffness", stiffness)
         mbs.SetObjectParameter(index, "damping", damping)
+        if self.offset_in_item:
+            mbs.SetObjectParameter(index, "offset", self.offset)
         self._set_user_function(mbs, index, user_functions)
         self.index = index
 
@@ -193,7 +207,7 @@ class Connector(abc.ABC):
         if not self.needs_user_function:
             return
         self._user_function = record_spring_force_law(mbs, index, self.user_function_law(ops_for(user_functions)),
-                                                      user_functions)
+                                                      user_functions, with_offset=self.offset_in_item)
 
     # ------------------------------------------------------------------ energy (derived unless closed form)
     def python_stored_energy(self, d: float) -> float:
@@ -371,13 +385,18 @@ def add_connector_item(mbs, marker_a, marker_b, stiffness: float = 0.0, damping:
         visualization={"show": False, "drawSize": -1.0, "color": [-1.0, -1.0, -1.0, -1.0]}))
 
 
-def record_spring_force_law(mbs, index, law: Callable, user_functions: str):
+def record_spring_force_law(mbs, index, law: Callable, user_functions: str, *, with_offset: bool = False):
     """Record ``law(d, rate) -> F`` (N, over the backend's ops) as the spring-force user function of the connector
     item ``index`` (``user_functions``: ``"symbolic"`` or ``"python"``); return what Exudyn holds, which must be kept
-    alive as long as the system."""
+    alive as long as the system.  ``with_offset``: ``law(d, rate, offset)``, the offset (m) the item holds, as
+    Exudyn passes it (:attr:`Connector.offset_in_item`)."""
 
-    def user_function(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
-        return law(displacement, velocity)
+    if with_offset:
+        def user_function(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
+            return law(displacement, velocity, offset)
+    else:
+        def user_function(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
+            return law(displacement, velocity)
 
     recorded = make_user_function(mbs, user_function, user_functions, index)
     mbs.SetObjectParameter(index, "springForceUserFunction", recorded)

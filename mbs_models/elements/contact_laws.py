@@ -389,6 +389,9 @@ class ContactConnector(Connector):
     needs_user_function = True
     records_force = True
     is_contact = True
+    offset_in_item = True
+    #: (the law reads the numbers copied from ``spec`` in __init__, never ``spec`` itself)
+    law_state_ignores = frozenset({"spec"})
 
     def __init__(self, name: str, element: str, a: str, b: str, spec, offset: float, *, conventions=None):
         super().__init__(name, element, a, b)
@@ -416,32 +419,34 @@ class ContactConnector(Connector):
         """p = d - offset (m), > 0 in contact."""
         return d - self.offset
 
-    def law(self, d, rate, ops: Ops, lam=None):
+    def law(self, d, rate, ops: Ops, lam=None, offset=None):
+        """The force (N); ``offset``: the offset to use (m; the item's, in a user function), default :attr:`offset`."""
         if lam is None and self.capture is not None:
             lam = self.capture.lam
-        return law_force(d, rate, self.law_name, self.contact_stiffness, self.exponent, self.offset, ops,
-                         damping_factor=self.damping_factor, damping=self.contact_damping,
-                         compression_only=self.compression_only, lam=lam)
+        return law_force(d, rate, self.law_name, self.contact_stiffness, self.exponent,
+                         self.offset if offset is None else offset, ops, damping_factor=self.damping_factor,
+                         damping=self.contact_damping, compression_only=self.compression_only, lam=lam)
 
     def user_function_law(self, ops: Ops) -> Callable:
-        """:meth:`law` as Exudyn's user function.  Symbolic: ``select(d > offset, F(d, d'), 0)`` -- every law's force
-        is 0 while the contact is open (``p <= 0``: a zero penetration's power times a finite factor, clipped at 0),
-        and Exudyn evaluates only the branch a selection takes, so an open contact costs a comparison instead of
-        the law (its power function); in contact it is the law's own expression."""
+        """:meth:`law` as Exudyn's user function ``f(d, d', offset)``, the offset the item holds
+        (:attr:`~mbs_models.elements.connector.Connector.offset_in_item`: the law uses it only as ``d - offset``).
+        Symbolic: ``select(d > offset, F(d, d'), 0)`` -- every law's force is 0 while the contact is open (``p <=
+        0``: a zero penetration's power times a finite factor, clipped at 0), and Exudyn evaluates only the branch
+        a selection takes, so an open contact costs a comparison instead of the law (its power function); in
+        contact it is the law's own expression."""
         if self.capture is None:
-            law = lambda d, rate: self.law(d, rate, ops)  # noqa: E731
+            law = lambda d, rate, offset: self.law(d, rate, ops, offset=offset)  # noqa: E731
         elif ops.name == "symbolic":
             import exudyn
             variable = exudyn.symbolic.Real(f"lam_{self.name}_{id(self)}", self.capture.lam)
             self.capture._variable = variable
-            law = lambda d, rate: self.law(d, rate, ops, lam=variable)  # noqa: E731
+            law = lambda d, rate, offset: self.law(d, rate, ops, lam=variable, offset=offset)  # noqa: E731
         else:
             capture = self.capture
-            law = lambda d, rate: self.law(d, rate, ops, lam=capture.lam)  # noqa: E731
+            law = lambda d, rate, offset: self.law(d, rate, ops, lam=capture.lam, offset=offset)  # noqa: E731
         if ops.name != "symbolic":
             return law
-        offset = self.offset
-        return lambda d, rate: ops.select(d > offset, law(d, rate), 0.0)
+        return lambda d, rate, offset: ops.select(d > offset, law(d, rate, offset), 0.0)
 
     def force(self, d, rate, t=None):
         lam = None

@@ -33,9 +33,10 @@ from .law_state import same_laws
 
 def foldable(connector: Connector) -> bool:
     """True if ``connector`` may share its item: the plain connector item (``add_items`` and ``update_items`` of
-    :class:`~mbs_models.elements.connector.Connector`) and no force sensor on it."""
+    :class:`~mbs_models.elements.connector.Connector`), no force sensor on it and no offset held by the item (one
+    item has one offset)."""
     kind = type(connector)
-    return (not connector.records_force and kind.add_items is Connector.add_items
+    return (not connector.records_force and not connector.offset_in_item and kind.add_items is Connector.add_items
             and kind.update_items is Connector.update_items)
 
 
@@ -110,6 +111,8 @@ def update_item(mbs, index, members: Sequence[Connector], user_functions: str = 
         for old, new in zip(recorded, members):
             if "_user_function" in vars(old):
                 new._user_function = old._user_function
+            if new.offset_in_item:  # (the one number the law takes from the item: Connector.update_items writes it)
+                mbs.SetObjectParameter(index, "offset", new.offset)
             new.index = index
         return
     if len(members) == 1:

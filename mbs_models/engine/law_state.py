@@ -48,12 +48,17 @@ def same_value(a: Any, b: Any) -> bool:
 
 def same_law(old, new) -> bool:
     """True if connector ``new`` has the law of connector ``old``: the same class, and every attribute but the
-    engine's (:data:`ENGINE_ATTRIBUTES`) equal by value."""
+    engine's (:data:`ENGINE_ATTRIBUTES`) and those the class says its law does not read (``law_state_ignores``)
+    equal by value; ``offset`` left out too for a class whose item holds it
+    (:attr:`~mbs_models.elements.connector.Connector.offset_in_item`: the item's offset is written anew)."""
     if type(old) is not type(new) or not hasattr(new, "__dict__") or not hasattr(old, "__dict__"):
         return False  # (another class, or attributes in slots: not compared)
     mine, theirs = vars(new), vars(old)
-    names = mine.keys() - ENGINE_ATTRIBUTES
-    if names != theirs.keys() - ENGINE_ATTRIBUTES:
+    kind = type(new)
+    ignored = (ENGINE_ATTRIBUTES | getattr(kind, "law_state_ignores", frozenset())
+               | ({"offset"} if getattr(kind, "offset_in_item", False) else set()))
+    names = mine.keys() - ignored
+    if names != theirs.keys() - ignored:
         return False
     return all(same_value(theirs[name], mine[name]) for name in names)
 

@@ -215,7 +215,7 @@ def test_the_symbolic_user_function_is_the_law_in_contact_and_zero_when_open(law
     for p in (-0.01, -1e-9, 0.0, 1e-9, 1e-4, 0.01):
         for rate in (-3.0, -0.2, 0.0, 0.5, 4.0):
             d, v = exudyn.symbolic.Real(offset + p), exudyn.symbolic.Real(rate)
-            value = recorded(d, v).Evaluate()
+            value = recorded(d, v, exudyn.symbolic.Real(offset)).Evaluate()
             if offset + p > offset:
                 assert value == connector.law(d, v, ops).Evaluate(), (p, rate)
             else:
