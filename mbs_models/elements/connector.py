@@ -82,6 +82,10 @@ class Connector(abc.ABC):
        corners of the box for a monotone law, else a dense sampling with a margin), and a quadratic potential
        (:attr:`quadratic_potential` with :attr:`quadratic_stiffness`: the energy bounds of the early stop then
        use it in their quadratic form; otherwise the potential enters them as a function).
+       For sweeps (optional, nothing to do by default): :attr:`offset_in_item` if the law reads an ``offset``
+       attribute only as ``d - offset`` and ``d > offset`` (its recording then serves every offset), and
+       :attr:`law_state_ignores` naming attributes the law does not read (a kept item's recording serves any
+       connector equal in the rest; :mod:`mbs_models.engine.law_state`).
     5. Write its reference term in ``validation/reference/terms`` (or register one from your module,
        :func:`validation.reference.terms.register_term`) and register the element's table
        (:func:`mbs_models.register_element` from outside the package).
