@@ -145,6 +145,30 @@ def check_backends(connector, box) -> None:
                 f"{connector!r}: F({di:.6g}, {ri:.6g}) = {python!r} N in Python, {value!r} N over {name}")
 
 
+def check_item_offset(connector, box) -> None:
+    """A connector whose Exudyn item holds its offset (``offset_in_item``): its user function given another offset
+    o is, bit for bit, the law of the same connector with offset o -- over Python floats and Exudyn symbolic
+    expressions, at the sampled states moved with the offset (so that the penetrations stay those of the box)."""
+    if not connector.offset_in_item:
+        return
+    import copy
+
+    import exudyn
+
+    real = exudyn.symbolic.Real
+    mine = copy.deepcopy(connector)  # (recording a capture's law gives the capture a variable: not the shared one)
+    python_function, symbolic_function = mine.user_function_law(PYTHON_OPS), mine.user_function_law(symbolic_ops())
+    for shift in (-0.013, 0.007):
+        other = copy.deepcopy(connector)
+        other.offset = connector.offset + shift
+        for d, rate in states(connector, box, count=16):
+            moved = d + shift
+            expected = other.law(moved, rate, PYTHON_OPS)
+            assert python_function(moved, rate, other.offset) == expected, (connector, moved, rate)
+            recorded = symbolic_function(real(moved), real(rate), real(other.offset)).Evaluate()
+            assert recorded == other.law(real(moved), real(rate), symbolic_ops()).Evaluate(), (connector, moved, rate)
+
+
 def check_all(connector) -> None:
     """Every clause above on every box of the connector."""
     for box in boxes(connector):
@@ -152,6 +176,7 @@ def check_all(connector) -> None:
         check_potential(connector, box)
         check_tangent_stiffness(connector, box)
         check_backends(connector, box)
+        check_item_offset(connector, box)
 
 
 #: The metric and the time of it that an early stop reports (names of Result fields).

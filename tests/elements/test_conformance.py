@@ -1,7 +1,8 @@
 """The element contract, checked on every connector of every shipped scene (mbs_models/scenes/*.toml) and on
 every law of every contact (the ``contact_*`` scenes hold one law each): the clauses of
 ``tests/conformance.py`` -- force bound >= |F|, closed-form U = integral of F(s, 0), closed-form tangent
-stiffness = dF/dd, Python = numpy = symbolic -- and the early stop on a weak-damper variant of each scene.
+stiffness = dF/dd, Python = numpy = symbolic, a user function given its item's offset is the law at that offset
+(``offset_in_item``) -- and the early stop on a weak-damper variant of each scene.
 
 Deliberately broken elements (a progressive spring whose author wrote a wrong closed-form force bound, or a
 wrong closed-form potential: the two omissions of issue #21) must fail the same checks.
@@ -51,6 +52,13 @@ def test_python_numpy_and_symbolic_backends_agree(key):
     connector = CONNECTORS[key]
     for box in conformance.boxes(connector):
         conformance.check_backends(connector, box)
+
+
+@pytest.mark.parametrize("key", [key for key, connector in CONNECTORS.items() if connector.offset_in_item])
+def test_a_user_function_given_another_offset_is_the_law_at_that_offset(key):
+    connector = CONNECTORS[key]
+    for box in conformance.boxes(connector):
+        conformance.check_item_offset(connector, box)
 
 
 def _weak_damper(scene):
