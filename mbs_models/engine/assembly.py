@@ -57,8 +57,9 @@ class Assembly:
     masses: body name -> ObjectIndex of its ``ObjectMass1D``.
     structure: :func:`structure_key` of the system (what :func:`refill` needs to match).
     item_layout: ``(object index, its ODE2 coordinates, has a mass matrix, has an ODE2 LHS, the body whose
-        ObjectMass1D it is or None)`` per object with ODE2 coordinates, filled by the first evaluation of the initial accelerations
-        (:func:`~mbs_models.engine.driver._initial_accelerations`) and kept by :func:`refill` (the structure's).
+        ObjectMass1D it is or None)`` per object with ODE2 coordinates, filled by the first evaluation of the
+        initial accelerations (:func:`~mbs_models.engine.driver._initial_accelerations`) and kept by
+        :func:`refill` (the structure's).
     simulation_settings: Exudyn ``SimulationSettings`` per ``(SolverSettings, end time, start time)`` solved with
         (:func:`~mbs_models.engine.driver._simulation_settings`), kept by :func:`refill`.
     planar: the carriage's items (:class:`~mbs_models.engine.planar.PlanarItems`) of a scene with a
@@ -234,9 +235,9 @@ def refill(assembly: Assembly, scene: Scene, mechanism: Mechanism, key: tuple | 
     :func:`structure_key`): every body's mass and initial state, and every connector's and load's numbers and user
     function (their ``update_items``), written in place (an item whose connectors have the laws it holds keeps its
     recorded user function: :func:`~mbs_models.engine.folding.update_item`); then ``mbs.Assemble()`` (the initial
-    state, as at the first assembly), no pre-step function.  Returns the new :class:`Assembly` (``assembly`` must not be used
-    any more).  ValueError if the structures differ (``key``: the scene's :func:`structure_key`, if already at
-    hand)."""
+    state, as at the first assembly), no pre-step function.  Returns the new :class:`Assembly` (``assembly`` must
+    not be used any more).  ValueError if the structures differ (``key``: the scene's :func:`structure_key`, if
+    already at hand)."""
     backend = assembly.backend
     if assembly.planar is not None or scene.carriage is not None:
         raise ValueError("a carriage scene is assembled anew for every solve")
