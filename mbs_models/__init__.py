@@ -10,8 +10,8 @@ Public API (one entry point per task)::
     lighter = apply_overrides(model_ii(), {"absorber.mass": 500.0, "contact.gap": 0.02})   # dotted keys
     table = run_sweep(model_ii(), {"absorber.mass": [100, 1000], "contact.gap": "0:0.12:13"}, out="gaps.csv")
 
-Scenes (:mod:`.scene`) and their elements' tables (:mod:`.elements`) are imported eagerly and need no
-Exudyn; the engine (:mod:`.engine`), results (:mod:`.results`) and studies are imported on first use,
+Scenes (:mod:`.scene`) are imported eagerly and need no Exudyn; an element's module (:mod:`.elements`) is imported
+when one of its tables is first used (a scene that has it, its class looked up here); the engine (:mod:`.engine`), results (:mod:`.results`) and studies are imported on first use,
 so that scenes can be read, checked and written without ever loading Exudyn.
 """
 
@@ -25,7 +25,6 @@ from .scene import (TABLE_CLASSES, Conventions, Scene, apply_overrides, load_sce
                     parse_spec, scene_from_dict, scene_to_dict, scene_to_toml, simplified_model)
 from .stop_reason import StopReason
 
-globals().update(TABLE_CLASSES)  # Barrel, RecoilSpring, Absorber, Contact, ...: every element's table
 
 __version__ = "0.1.0"
 
@@ -66,6 +65,8 @@ __all__ = [
 
 
 def __getattr__(name: str):
+    if name in TABLE_CLASSES:  # Barrel, RecoilSpring, Absorber, Contact, ...: every element's table
+        return TABLE_CLASSES[name]
     if name in _LAZY:
         value = getattr(importlib.import_module(_LAZY[name], __name__), name)
         globals()[name] = value

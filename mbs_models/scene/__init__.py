@@ -20,10 +20,17 @@ from .io import FORMAT_VERSION, FORMAT_VERSIONS, load_scene, scene_from_dict, sc
 from .overrides import apply_overrides, parse_spec, parse_value
 from .models import model_i, model_ii, paper_model, simplified_model
 
-#: Every element's table class by its class name (``Barrel``, ``RecoilSpring``, ``Contact``, ...): re-exported
-#: from the element registry, so that a new element is public without being named here.
-TABLE_CLASSES = {cls.__name__: cls for cls in TABLES.values()}
-globals().update(TABLE_CLASSES)
+#: Every shipped element's table class by its class name (``Barrel``, ``RecoilSpring``, ``Contact``, ...):
+#: re-exported from the element registry, so that a new element is public without being named here.  A read-only
+#: mapping that imports a table's element module when its class is first looked up (:mod:`mbs_models.elements
+#: .registry`); the classes are this module's and the package's attributes (PEP 562).
+TABLE_CLASSES = TABLES.by_class_name()
+
+
+def __getattr__(name: str):
+    if name in TABLE_CLASSES:
+        return TABLE_CLASSES[name]
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 __all__ = ["Scene", "Conventions", *TABLE_CLASSES, "TABLE_CLASSES", "CONTACT_LAWS", "MOUNTS",
            "PAPER_ROUNDED_INITIAL_VELOCITY", "FORMAT_VERSION", "FORMAT_VERSIONS", "load_scene", "scene_from_dict",

@@ -76,16 +76,18 @@ def _many_attribute(table: str) -> str:
     return table + "s"
 
 
-_SINGLE: dict[str, type] = {}
-_MANY: dict[str, type] = {}
+#: The single tables' names, and the arrays' scene attributes (``absorbers``) -> table name, in element order.
+_SINGLE: dict[str, str] = {}
+_MANY: dict[str, str] = {}
 
 
 def _refresh_views() -> None:
-    """The single and array tables of :data:`ELEMENT_TABLES` (again after :func:`~mbs_models.register_element`)."""
+    """The single and array tables of :data:`ELEMENT_TABLES` (again after :func:`~mbs_models.register_element`);
+    by name, importing no element module."""
     _SINGLE.clear()
-    _SINGLE.update((name, cls) for name, cls in ELEMENT_TABLES.items() if not cls.MANY)
+    _SINGLE.update((name, name) for name in ELEMENT_TABLES if not ELEMENT_TABLES.many(name))
     _MANY.clear()
-    _MANY.update((_many_attribute(name), cls) for name, cls in ELEMENT_TABLES.items() if cls.MANY)
+    _MANY.update((_many_attribute(name), name) for name in ELEMENT_TABLES if ELEMENT_TABLES.many(name))
 
 
 _refresh_views()
@@ -141,22 +143,25 @@ class Scene:
     @staticmethod
     def _normalise(parts: dict[str, Any]) -> tuple:
         out = []
-        for table, cls in ELEMENT_TABLES.items():
-            if cls.MANY:
+        for table in ELEMENT_TABLES:  # an absent table's class is not needed (nor its module imported)
+            if ELEMENT_TABLES.many(table):
                 attribute = _many_attribute(table)
                 value = parts.get(attribute)
                 value = () if value is None else value
                 if isinstance(value, Table) or not isinstance(value, (list, tuple)):
-                    raise SceneError(attribute, f"must be a sequence of {cls.__name__} tables, got "
-                                                f"{type(value).__name__}")
-                for i, item in enumerate(value):
-                    if not isinstance(item, cls):
-                        raise SceneError(f"{table}.{i}", f"must be a {cls.__name__}, got {type(item).__name__}")
+                    raise SceneError(attribute, f"must be a sequence of {ELEMENT_TABLES.class_name(table)} tables, "
+                                                f"got {type(value).__name__}")
+                if value:
+                    cls = ELEMENT_TABLES[table]
+                    for i, item in enumerate(value):
+                        if not isinstance(item, cls):
+                            raise SceneError(f"{table}.{i}", f"must be a {cls.__name__}, got {type(item).__name__}")
                 out.append((attribute, tuple(value)))
             else:
                 value = parts.get(table)
-                if value is not None and not isinstance(value, cls):
-                    raise SceneError(table, f"must be a {cls.__name__} or absent, got {type(value).__name__}")
+                if value is not None and not isinstance(value, ELEMENT_TABLES[table]):
+                    raise SceneError(table, f"must be a {ELEMENT_TABLES.class_name(table)} or absent, got "
+                                            f"{type(value).__name__}")
                 out.append((table, value))
         return tuple(out)
 
@@ -257,7 +262,7 @@ class Scene:
         out = []
         for key, value in self._parts:
             if isinstance(value, tuple):
-                table = ELEMENT_TABLES[key[:-1]].TABLE
+                table = _MANY[key]
                 out += [(table if len(value) == 1 else f"{table}.{i}", item) for i, item in enumerate(value)]
             elif value is not None:
                 out.append((key, value))

@@ -113,9 +113,10 @@ def scene_from_dict(data: dict[str, Any]) -> Scene:
         raise SceneError("barrel", "missing required table [barrel]")
 
     tables: dict[str, Any] = {}
-    for table, cls in ELEMENT_TABLES.items():
+    for table in ELEMENT_TABLES:
         if table not in data:
             continue
+        cls = ELEMENT_TABLES[table]
         if cls.SINCE_VERSION > version:
             raise SceneError(table, f"[{table}] needs a version-{cls.SINCE_VERSION} scene "
                                     f"(put version = {cls.SINCE_VERSION} at the top)")
@@ -172,8 +173,8 @@ def load_scene(path: str | Path) -> Scene:
 def scene_to_dict(scene: Scene) -> dict[str, Any]:
     """The version-2 TOML mapping of a scene (inverse of :func:`scene_from_dict`); omits absent tables."""
     out: dict[str, Any] = {"version": FORMAT_VERSION, "name": scene.name}
-    for table, cls in ELEMENT_TABLES.items():
-        if cls.MANY:
+    for table in ELEMENT_TABLES:
+        if ELEMENT_TABLES.many(table):
             items = getattr(scene, table + "s")
             if items:
                 out[table] = [item.to_mapping() for item in items]

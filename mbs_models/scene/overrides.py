@@ -44,10 +44,10 @@ _TOP_LEVEL: list[str] = []
 
 def _refresh_views() -> None:
     """The keys a dotted override may start with (again after :func:`~mbs_models.register_element`)."""
-    _SINGLE_TABLES[:] = [name for name, cls in ELEMENT_TABLES.items() if not cls.MANY]
+    _SINGLE_TABLES[:] = [name for name in ELEMENT_TABLES if not ELEMENT_TABLES.many(name)]
     _ARRAY_TABLES.clear()
-    _ARRAY_TABLES.update((name, name + "s") for name, cls in ELEMENT_TABLES.items()
-                         if cls.MANY and name != "absorber")
+    _ARRAY_TABLES.update((name, name + "s") for name in ELEMENT_TABLES
+                         if ELEMENT_TABLES.many(name) and name != "absorber")
     _TOP_LEVEL[:] = sorted(["name", "conventions", "contact", "absorber", *_SINGLE_TABLES, *_ARRAY_TABLES])
 
 
