@@ -17,7 +17,8 @@ What it measures (not a timed test: the numbers depend on the machine; the ratio
    ctypes: the physical limit of what an integrator of these equations costs.  Skipped (and said so)
    without a C compiler.  Beside it, Exudyn's floor: the same Exudyn system with built-in linear laws only, no
    sensors and no pre-step function, per step, at the standard run's step count (what no change of this
-   product can go below).
+   product can go below); and what a step adds to that floor, one layer at a time (:data:`STEP_LAYERS`: the laws'
+   symbolic user functions, the pre-step function, the stored sensors), per accepted step and per attempt.
 3. **Single-run cost breakdown**: import (in a fresh interpreter), assembly, solve, post-processing (and
    its parts), as fractions of one complete run.
 4. **Memory**: RSS over N consecutive runs in this process (Exudyn keeps models alive unless reset;
@@ -255,6 +256,27 @@ def exudyn_floor_round(scene, end_time: float, fold: bool = False) -> tuple[floa
                              fold=fold)
 
 
+#: What a step of the standard solve adds to Exudyn's floor, one thing at a time (:func:`step_layers_round`): name ->
+#: (user functions for the laws, pre-step function, stored sensors).
+STEP_LAYERS = {
+    "Exudyn's floor (built-in linear laws, no pre-step, no sensors)": (False, False, False),
+    "the laws as symbolic user functions": (True, False, False),
+    "... and the pre-step function (the step budget)": (True, True, False),
+    "... and the stored sensors: the product's solve": (True, True, True),
+}
+
+
+def step_layers_round(scene, end_time: float) -> dict[str, tuple[float, int, int]]:
+    """One ``standard`` solve per :data:`STEP_LAYERS` entry, folded items as the engine assembles them: name ->
+    (solve wall time s, accepted steps, rejected steps).  Without the user functions the contact is gone and the
+    motion differs (fewer steps, fewer rejected): compare per step."""
+    import profile_solve
+
+    return {name: profile_solve.run_counted(scene, "symbolic", pre_step=pre, sensors=sensors, laws=laws,
+                                            end_time=end_time)
+            for name, (laws, pre, sensors) in STEP_LAYERS.items()}
+
+
 # ------------------------------------------------------------------------------------------------ memory
 
 def memory_test(scene, runs: int, end_time: float, progress) -> list[tuple[int, int]]:
@@ -385,6 +407,7 @@ def main(argv=None) -> int:
         add(f"{name} cpu", time.process_time() - cpu)
         return value
 
+    layer_steps: dict[str, tuple[int, int]] = {}
     for _ in range(args.repeats):
         run = clock("standard", simulate, scene, end_time, "standard")
         add("standard solve", run.timings["solve"])
@@ -400,6 +423,9 @@ def main(argv=None) -> int:
         add("exudyn floor per step", floor_seconds / floor_steps)
         floor_seconds, floor_steps = exudyn_floor_round(scene, end_time, fold=True)
         add("exudyn folded floor per step", floor_seconds / floor_steps)
+        for name, (seconds, accepted, rejected) in step_layers_round(scene, end_time).items():
+            add(f"layer {name}", seconds)
+            layer_steps[name] = (accepted, rejected)
     directory.cleanup()
     t = {name: statistics.median(values) for name, values in timings.items()}
     stages = {name: statistics.median(values) for name, values in stages.items()}
@@ -488,6 +514,23 @@ def main(argv=None) -> int:
           f"complete run / floor {t_standard / result.steps / floor_step:.2f}x (the floor with one item per connector; "
           f"with the connectors on the same ends folded, as the engine assembles them, {1e6 * t['exudyn folded floor per step']:.2f} us: "
           f"solve / folded floor {solve_step / t['exudyn folded floor per step']:.2f}x)")
+    floor_name = next(iter(STEP_LAYERS))
+    floor_accepted, floor_rejected = layer_steps[floor_name]
+    floor_per_step = t[f"layer {floor_name}"] / floor_accepted
+    floor_per_attempt = t[f"layer {floor_name}"] / (floor_accepted + floor_rejected)
+    record["step_layers"] = []
+    print("what a step of the standard solve adds to Exudyn's floor, one layer at a time (the items folded as the "
+          "engine assembles them; per accepted step, and per attempt: accepted + rejected):")
+    for name, (accepted, rejected) in layer_steps.items():
+        seconds = t[f"layer {name}"]
+        row = {"name": name, "solve_s": seconds, "steps": accepted, "rejected": rejected,
+               "per_step_s": seconds / accepted, "per_attempt_s": seconds / (accepted + rejected),
+               "per_step_over_floor": seconds / accepted / floor_per_step,
+               "per_attempt_over_floor": seconds / (accepted + rejected) / floor_per_attempt}
+        record["step_layers"].append(row)
+        print(f"   {name:64s} {accepted:5d} steps, {rejected:4d} rejected: {1e6 * row['per_step_s']:5.2f} us per step "
+              f"({row['per_step_over_floor']:4.2f}x the floor), {1e6 * row['per_attempt_s']:5.2f} us per attempt "
+              f"({row['per_attempt_over_floor']:4.2f}x)")
     print("\n1. standard vs scipy LSODA at equal accuracy (same equations, no events, dense output; the worst of the "
           "three metrics: section 9 matches each separately)")
     if lsoda is None:

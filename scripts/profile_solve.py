@@ -50,6 +50,13 @@ def run(scene, backend: str, pre_step: bool, sensors: bool, laws: bool = True,
     """One ``standard`` solve of ``scene`` to ``end_time`` (s) with or without the pre-step function, stored sensors
     and the user functions (``laws``: False puts Exudyn's built-in linear law in their place); returns (solve wall
     time s, steps)."""
+    return run_counted(scene, backend, pre_step, sensors, laws, end_time, fold)[:2]
+
+
+def run_counted(scene, backend: str, pre_step: bool, sensors: bool, laws: bool = True,
+                end_time: float = END, fold: bool = True) -> tuple[float, int, int]:
+    """:func:`run`, and the steps the solver rejected (Exudyn's ``rejectedAutomaticStepSizeSteps``): (solve wall
+    time s, accepted steps, rejected steps)."""
     settings = solver_settings_for("standard", backend)
     assembly = assemble(scene, backend, fold=fold)
     try:
@@ -72,7 +79,8 @@ def run(scene, backend: str, pre_step: bool, sensors: bool, laws: bool = True,
         start = time.perf_counter()
         mbs.SolveDynamic(ss, solverType=getattr(exudyn.DynamicSolverType, settings.solver))
         elapsed = time.perf_counter() - start
-        return elapsed, int(mbs.sys["dynamicSolver"].it.currentStepIndex)
+        counters = mbs.sys["dynamicSolver"].it
+        return elapsed, int(counters.currentStepIndex), int(counters.rejectedAutomaticStepSizeSteps)
     finally:
         assembly.close()
 

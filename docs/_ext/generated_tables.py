@@ -114,6 +114,17 @@ def bench_tables(data: dict) -> str:
         *[f"| {name} | {value:.1f}x |" if name.startswith("import") else f"| {name} | {100 * value:.1f} % |"
           for name, value in data["breakdown"].items()], "",
     ]
+    if data.get("step_layers"):
+        parts += ["### What a step adds to Exudyn's floor\n",
+                  "The `standard` solve with one layer of the product added at a time (the items folded as the engine "
+                  "assembles them). Without the laws' user functions the contact is gone and the motion differs: "
+                  "compare per step. An attempt is an accepted or a rejected step; Exudyn evaluates every item at every "
+                  "stage of both.\n",
+                  "| solve | steps | rejected | per step | / floor | per attempt | / floor |",
+                  "|---|---:|---:|---:|---:|---:|---:|",
+                  *[f"| {row['name']} | {row['steps']} | {row['rejected']} | {row['per_step_s'] * 1e6:.2f} µs | "
+                    f"{row['per_step_over_floor']:.2f}x | {row['per_attempt_s'] * 1e6:.2f} µs | "
+                    f"{row['per_attempt_over_floor']:.2f}x |" for row in data["step_layers"]], ""]
     if "elements" in data:
         parts += ["### What elements cost\n",
                   "The same motion split over n absorbers (cost relative to one absorber), and capturing the onset "

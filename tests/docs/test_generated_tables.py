@@ -95,3 +95,16 @@ def test_the_committed_benchmark_has_the_sections_its_command_ran(tables):
     assert ("carriage" in data) == ("--skip-carriage" not in command)
     assert ("issue24" in data) == ("--skip-issue24" not in command)
     tables.bench_tables(data)  # renders
+
+
+def test_what_a_step_adds_to_the_floor_is_rendered_layer_by_layer(tables):
+    data = _minimal()
+    assert "adds to Exudyn's floor" not in tables.bench_tables(data)  # (not measured: not rendered)
+    data["step_layers"] = [
+        {"name": "Exudyn's floor", "solve_s": 6.6e-4, "steps": 526, "rejected": 33, "per_step_s": 1.25e-6,
+         "per_attempt_s": 1.18e-6, "per_step_over_floor": 1.0, "per_attempt_over_floor": 1.0},
+        {"name": "the laws as symbolic user functions", "solve_s": 2.41e-3, "steps": 1314, "rejected": 237,
+         "per_step_s": 1.83e-6, "per_attempt_s": 1.55e-6, "per_step_over_floor": 1.464, "per_attempt_over_floor": 1.314}]
+    text = tables.bench_tables(data)
+    assert "| Exudyn's floor | 526 | 33 | 1.25 µs | 1.00x | 1.18 µs | 1.00x |" in text
+    assert "| the laws as symbolic user functions | 1314 | 237 | 1.83 µs | 1.46x | 1.55 µs | 1.31x |" in text
