@@ -88,6 +88,7 @@ class Tables(Mapping):
         return self._entries[name].order
 
     def class_name(self, name: str) -> str:
+        """The name of the table's class (``Recuperator``), for messages about a table not yet imported."""
         return self._entries[name].class_name
 
     def imported(self) -> list[str]:
