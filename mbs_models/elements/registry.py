@@ -24,7 +24,6 @@ import dataclasses
 import importlib
 import inspect
 import os
-import sys
 from collections.abc import Mapping
 from typing import Iterator
 
@@ -90,10 +89,6 @@ class Tables(Mapping):
     def class_name(self, name: str) -> str:
         """The name of the table's class (``Recuperator``), for messages about a table not yet imported."""
         return self._entries[name].class_name
-
-    def imported(self) -> list[str]:
-        """The names of the tables whose element modules are imported (for tests and benchmarks)."""
-        return [name for name, entry in self._entries.items() if entry.cls is not None or entry.module in sys.modules]
 
     def by_class_name(self) -> "Mapping[str, type]":
         """The tables now registered, by class name (``Barrel``, ``Contact``): a read-only mapping that imports

@@ -408,11 +408,14 @@ def _item_layout(assembly: Assembly) -> list:
             if not ltg:
                 continue
             index = exudyn.ObjectIndex(i)
+            body = body_of.get(i) if len(ltg) == 1 and i in body_of \
+                and assembly.mbs.GetObject(index)["objectType"] == "Mass1D" else None
+            if body is not None:  # (nothing is asked of Exudyn for it: see above)
+                assembly.item_layout.append((index, ltg, False, False, body))
+                continue
             applies = assembly.mbs.ComputeItem(index)
-            body = body_of.get(i) if len(ltg) == 1 and assembly.mbs.GetObject(index)["objectType"] == "Mass1D" \
-                else None
             assembly.item_layout.append((index, ltg, exudyn.ComputeItemType.MassMatrix in applies,
-                                         exudyn.ComputeItemType.ODE2LHS in applies, body))
+                                         exudyn.ComputeItemType.ODE2LHS in applies, None))
     return assembly.item_layout
 
 
